@@ -1,0 +1,19 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace msfem::compare {
+
+/// Each `msfem` sub-command: takes the arguments after its name, prints its result on stdout
+/// (diagnostics on stderr) and returns the process exit code. Bad input is reported by throwing
+/// msfem::cases::InputError (or std::invalid_argument for a bad option), which main() prints as one
+/// line and turns into exit code 2.
+using Arguments = std::vector<std::string>;
+
+int mesh_info_command(const Arguments& args);  // msfem mesh-info FILE [--unit mm]
+int simplify_command(const Arguments& args);   // msfem simplify IN OUT --vertices N [--smooth K]
+int bench_command(const Arguments& args);      // msfem bench massspring|fem [--json]
+int verify_command(const Arguments& args);     // msfem verify [--json]
+
+}  // namespace msfem::compare

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages msfem needs; skips what is present, runs `apt-get update` at most once.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build git pkg-config
+  libeigen3-dev          # massspring's only dependency: dense/sparse linear algebra
+  libnanoflann-dev       # k-d tree for the skeleton's 4-nearest control points (header-only)
+  libdeal.ii-dev         # FEM reference; brings PETSc (hypre, MUMPS), MPI, HDF5, Gmsh, CGAL, p4est
+  libcgal-dev            # surface validation (self-intersections) and simplification
+  libhdf5-dev            # fields.h5 output
+  nlohmann-json3-dev     # summary.json and every --json output
+  libgtest-dev           # unit and end-to-end tests
+  libbenchmark-dev       # speed measurements
+  gnuplot-nox            # plots in report.md
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo_cmd=()
+[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -q
+"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
