@@ -1,5 +1,6 @@
 #include "msfem/cases/surface_simplification.hpp"
 
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_filter.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 
@@ -29,7 +30,10 @@ Surface simplify(const Surface& surface, int target_vertices) {
   const std::size_t target_edges = mesh.number_of_edges() - 3 * removed;
   namespace SMS = CGAL::Surface_mesh_simplification;
   SMS::Count_stop_predicate<detail::CgalMesh> stop(target_edges + 1);
-  SMS::edge_collapse(mesh, stop);
+  // The filter refuses collapses that would turn a triangle over, the usual cause of folds (and
+  // so self-intersections) in tightly curved surfaces such as the cortex.
+  SMS::edge_collapse(mesh, stop,
+                     CGAL::parameters::filter(SMS::Bounded_normal_change_filter<>()));
   mesh.collect_garbage();
 
   Surface result = detail::from_cgal(mesh);
