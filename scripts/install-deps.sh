@@ -8,7 +8,7 @@ packages=(
   libnanoflann-dev       # k-d tree for the skeleton's 4-nearest control points (header-only)
   libdeal.ii-dev         # FEM reference; brings PETSc (hypre, MUMPS), MPI, HDF5, Gmsh, CGAL, p4est
   libcgal-dev            # surface validation (self-intersections) and simplification
-  libhdf5-dev            # fields.h5 output
+  libhdf5-openmpi-dev    # fields.h5 output (the HDF5 deal.II links, so one HDF5 per process)
   nlohmann-json3-dev     # summary.json and every --json output
   libgtest-dev           # unit and end-to-end tests
   libbenchmark-dev       # speed measurements

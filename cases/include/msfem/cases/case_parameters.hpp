@@ -1,0 +1,128 @@
+#pragma once
+// One problem stated once: geometry, material, supports and loads as geometry, the mass-spring
+// variants and the FEM reference to run on it, and what to time and write. Read from a deal.II
+// ParameterHandler file (`cases/*.prm`) by read_case(); plain structs so that users of a case need
+// no deal.II header.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "msfem/cases/units.hpp"
+
+namespace msfem::cases {
+
+struct GeometryParameters {
+  /// A surface file (relative paths are relative to the case file) or a generator spec such as
+  /// "icosphere:3:0.05" (see generate_surface()).
+  std::string source = "icosphere:3:0.05";
+  LengthUnit unit = LengthUnit::metre;  ///< unit of the file's coordinates
+  int simplify_to_vertices = 0;         ///< 0 keeps the surface as read
+  int smoothing_iterations = 0;         ///< Taubin iterations after simplification
+};
+
+struct MaterialParameters {
+  double youngs_modulus_pa = 3000.0;
+  double poisson_ratio = 0.45;
+  double density_kg_per_m3 = 1040.0;
+};
+
+/// The fixed region, stated as geometry; each model fixes the nodes it contains.
+struct SupportParameters {
+  enum class Kind { inner_core, half_space, sphere };
+  Kind kind = Kind::inner_core;
+  /// inner core: nodes inside the surface scaled by 1/scale about its vertex centroid.
+  double inner_core_scale = 2.0;
+  /// half-space: nodes x with (x - point)·outward_normal >= 0 are fixed.
+  Eigen::Vector3d half_space_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half_space_normal = -Eigen::Vector3d::UnitZ();
+  /// sphere: nodes within radius of center are fixed.
+  Eigen::Vector3d sphere_center = Eigen::Vector3d::Zero();
+  double sphere_radius_m = 0.0;
+};
+
+/// A rigid sphere pushed along the inward normal at a surface point. The point is the surface
+/// vertex that lies farthest from the vertex centroid along `direction`.
+struct ToolParameters {
+  bool enabled = true;
+  enum class Mode { prescribed, contact };
+  Mode mode = Mode::prescribed;
+  std::vector<Eigen::Vector3d> directions = {Eigen::Vector3d::UnitZ()};
+  double radius_m = 0.005;
+  double depth_m = 0.005;
+  /// Depths of the force-depth curve (empty: depth/4, depth/2, 3 depth/4, depth).
+  std::vector<double> curve_depths_m;
+};
+
+/// A total force spread over the surface vertices within radius of the point farthest along
+/// `direction` (the pancreas paper's user drag).
+struct PatchForceParameters {
+  bool enabled = false;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  double radius_m = 0.01;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+};
+
+struct LoadParameters {
+  ToolParameters tool;
+  Eigen::Vector3d gravity_m_per_s2 = Eigen::Vector3d::Zero();
+  PatchForceParameters patch_force;
+};
+
+/// Knobs of the mass-spring variants. Stiffness starts from the analytic value (Lloyd et al. 2007
+/// or van Gelder 1998) times a per-group factor; damping is a damping ratio of the slowest... see
+/// docs.
+struct MassSpringParameters {
+  std::vector<std::string> variants = {"three_tier", "single_layer", "tet_edges", "skeleton"};
+  std::string stiffness_model = "lloyd";  ///< lloyd | van_gelder
+  double damping_ratio = 0.5;             ///< spring dampers as a fraction of critical
+  std::vector<std::pair<std::string, double>> group_scales;  ///< "group:factor" overrides
+  double middle_tier_scale = 1.2;
+  double inner_tier_scale = 2.0;
+  std::string inner_tiers = "scaled";  ///< scaled | offset (along the inward normal)
+  int skeleton_control_points = 0;     ///< 0: a tenth of the surface vertices, at least 20
+  double skeleton_draw_factor = 0.5;   ///< control points drawn toward the centroid by this factor
+};
+
+struct FemParameters {
+  int degree = 2;
+  double cell_size_m = 0.0;        ///< 0: from the surface's mean edge length
+  std::string solver = "cg_gamg";  ///< cg_gamg | cg_boomeramg | mumps
+  double relative_tolerance = 1e-10;
+};
+
+struct TimingParameters {
+  std::string integrator = "symplectic_euler";
+  double dt_s = 0.0;  ///< 0: half the estimated stable step
+  int steps = 2000;   ///< dynamic steps timed for steps/s
+};
+
+struct OutputParameters {
+  std::string directory = "results/runs";
+};
+
+struct CaseParameters {
+  std::string name;            ///< case file name without extension
+  std::filesystem::path file;  ///< where it was read from
+  GeometryParameters geometry;
+  MaterialParameters material;
+  SupportParameters support;
+  LoadParameters loads;
+  MassSpringParameters mass_spring;
+  FemParameters fem;
+  TimingParameters timing;
+  OutputParameters output;
+};
+
+/// Reads a case file, then applies `overrides` ("section/key=value", or "section/sub/key=value").
+/// Every key is typed, ranged and documented; an unknown key, a typo, a value outside its range or
+/// a bad override throws InputError with one line naming the file and line (or the override).
+CaseParameters read_case(const std::filesystem::path& file,
+                         const std::vector<std::string>& overrides = {});
+
+/// The whole input language (every section, key, default, pattern and documentation).
+std::string describe_case_parameters();
+
+}  // namespace msfem::cases

@@ -1,0 +1,358 @@
+// The case file language, declared once with deal.II's ParameterHandler (step-44 style): every key
+// has a pattern and a documentation string, so `msfem params` can print the whole language. This is
+// the only translation unit of cases/ that includes deal.II.
+#include <deal.II/base/exceptions.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/patterns.h>
+#include <deal.II/base/utilities.h>
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/errors.hpp"
+
+namespace msfem::cases {
+namespace {
+
+using dealii::ParameterHandler;
+namespace Patterns = dealii::Patterns;
+
+const char* const variant_names = "three_tier|single_layer|tet_edges|skeleton";
+
+Patterns::List point_pattern() {
+  return Patterns::List(Patterns::Double(), 3, 3, ",");
+}
+
+void declare_geometry(ParameterHandler& prm) {
+  prm.enter_subsection("geometry");
+  prm.declare_entry("source", "icosphere:3:0.05", Patterns::Anything(),
+                    "Closed surface: a file (.obj .stl .off .ply; relative to the case file) or "
+                    "a generator, icosphere:LEVEL[:RADIUS_M] or ellipsoid:LEVEL:A:B:C (metres).");
+  prm.declare_entry("unit", "m", Patterns::Selection("m|cm|mm"),
+                    "Unit of the surface file's coordinates; msfem works in metres.");
+  prm.declare_entry("simplify to vertices", "0", Patterns::Integer(0),
+                    "Edge-collapse the surface to this many vertices (0 keeps it as read).");
+  prm.declare_entry("smoothing iterations", "0", Patterns::Integer(0, 1000),
+                    "Taubin smoothing iterations applied after simplification.");
+  prm.leave_subsection();
+}
+
+void declare_material(ParameterHandler& prm) {
+  prm.enter_subsection("material");
+  prm.declare_entry("youngs modulus", "3000", Patterns::Double(0),
+                    "Young's modulus E in Pa (brain 1.4-3 kPa, pancreas 1.4-4 kPa); must be > 0.");
+  prm.declare_entry("poisson ratio", "0.45", Patterns::Double(-0.999, 0.4999),
+                    "Poisson's ratio; a plain spring network is exact only at 0.25.");
+  prm.declare_entry("density", "1040", Patterns::Double(0), "Density in kg/m^3; must be > 0.");
+  prm.leave_subsection();
+}
+
+void declare_support(ParameterHandler& prm) {
+  prm.enter_subsection("support");
+  prm.declare_entry("fixed region", "inner core",
+                    Patterns::Selection("inner core|half space|sphere"),
+                    "Which nodes are fixed: inside the surface scaled by 1/scale about its "
+                    "centroid, in a half space, or in a sphere.");
+  prm.declare_entry("inner core scale", "2.0", Patterns::Double(1.0),
+                    "The inner core is the surface scaled by 1/scale (> 1).");
+  prm.declare_entry("half space point", "0,0,0", point_pattern(),
+                    "A point on the half space's plane (m).");
+  prm.declare_entry("half space normal", "0,0,-1", point_pattern(),
+                    "Normal pointing into the fixed half space.");
+  prm.declare_entry("sphere center", "0,0,0", point_pattern(), "Centre of the fixed sphere (m).");
+  prm.declare_entry("sphere radius", "0", Patterns::Double(0), "Radius of the fixed sphere (m).");
+  prm.leave_subsection();
+}
+
+void declare_loads(ParameterHandler& prm) {
+  prm.enter_subsection("loads");
+  prm.declare_entry("gravity", "0,0,0", point_pattern(), "Gravitational acceleration (m/s^2).");
+  prm.enter_subsection("tool");
+  prm.declare_entry("enabled", "true", Patterns::Bool(), "Press a rigid spherical tool.");
+  prm.declare_entry("mode", "prescribed", Patterns::Selection("prescribed|contact"),
+                    "prescribed: the contact patch moves with the tool; contact: frictionless "
+                    "contact, nodes inside the sphere are projected onto it.");
+  prm.declare_entry(
+      "directions", "0,0,1", Patterns::List(point_pattern(), 1, Patterns::List::max_int_value, ";"),
+      "Where the tool presses, one indentation per entry (';'-separated): the surface "
+      "vertex farthest from the centroid along each direction.");
+  prm.declare_entry("radius", "0.005", Patterns::Double(0), "Tool radius (m).");
+  prm.declare_entry("depth", "0.005", Patterns::Double(0),
+                    "Indentation depth along the inward normal (m).");
+  prm.declare_entry("curve depths", "", Patterns::List(Patterns::Double(0)),
+                    "Depths (m) of the force-depth curve; empty: a quarter, half, three quarters "
+                    "and all of the depth.");
+  prm.leave_subsection();
+  prm.enter_subsection("patch force");
+  prm.declare_entry("enabled", "false", Patterns::Bool(), "Pull a surface patch.");
+  prm.declare_entry("direction", "1,0,0", point_pattern(),
+                    "The patch is centred on the vertex farthest along this direction.");
+  prm.declare_entry("radius", "0.01", Patterns::Double(0), "Patch radius (m).");
+  prm.declare_entry("force", "0,0,0", point_pattern(), "Total force on the patch (N).");
+  prm.leave_subsection();
+  prm.leave_subsection();
+}
+
+void declare_mass_spring(ParameterHandler& prm) {
+  prm.enter_subsection("mass spring");
+  prm.declare_entry("variants", "three_tier, single_layer, tet_edges, skeleton",
+                    Patterns::List(Patterns::Selection(variant_names), 1),
+                    "Mass-spring variants to build and compare with the FEM.");
+  prm.declare_entry("stiffness model", "lloyd", Patterns::Selection("lloyd|van_gelder"),
+                    "Analytic starting stiffness: Lloyd et al. 2007 or van Gelder 1998.");
+  prm.declare_entry("damping ratio", "0.5", Patterns::Double(0),
+                    "Spring dampers as a fraction of critical damping.");
+  prm.declare_entry("group scales", "", Patterns::List(Patterns::Anything()),
+                    "Per spring group stiffness factors, GROUP:FACTOR, e.g. tier1_edges:1.5.");
+  prm.enter_subsection("three tier");
+  prm.declare_entry("middle tier scale", "1.2", Patterns::Double(1.0),
+                    "Tier 2 is the surface scaled by 1/scale about its centroid.");
+  prm.declare_entry("inner tier scale", "2.0", Patterns::Double(1.0),
+                    "Tier 3 (fixed) is the surface scaled by 1/scale.");
+  prm.declare_entry("inner tiers", "scaled", Patterns::Selection("scaled|offset"),
+                    "Build inner tiers by scaling, or by offsetting along the inward normal "
+                    "(safe for concave surfaces).");
+  prm.leave_subsection();
+  prm.enter_subsection("skeleton");
+  prm.declare_entry("control points", "0", Patterns::Integer(0),
+                    "Number of skeleton control points (0: a tenth of the surface vertices, at "
+                    "least 20).");
+  prm.declare_entry("draw factor", "0.5", Patterns::Double(0.0, 1.0),
+                    "Control points are drawn toward the centroid by this factor.");
+  prm.leave_subsection();
+  prm.leave_subsection();
+}
+
+void declare_fem_timing_output(ParameterHandler& prm) {
+  prm.enter_subsection("fem");
+  prm.declare_entry("degree", "2", Patterns::Integer(1, 2),
+                    "Polynomial degree of the simplex elements (P1 locks near ν = 0.5).");
+  prm.declare_entry("cell size", "0", Patterns::Double(0),
+                    "Target tetrahedron size (m); 0: the surface's mean edge length.");
+  prm.declare_entry("solver", "cg_gamg", Patterns::Selection("cg_gamg|cg_boomeramg|mumps"),
+                    "PETSc solver: CG with GAMG (rigid-body near-null space), CG with hypre "
+                    "BoomerAMG, or the MUMPS direct solver.");
+  prm.declare_entry("relative tolerance", "1e-10", Patterns::Double(0, 1),
+                    "Relative residual at which the iterative solver stops.");
+  prm.leave_subsection();
+  prm.enter_subsection("timing");
+  prm.declare_entry(
+      "integrator", "symplectic_euler",
+      Patterns::Selection("explicit_euler|symplectic_euler|verlet|rk4|implicit_euler"),
+      "Integrator whose steps are timed.");
+  prm.declare_entry("dt", "0", Patterns::Double(0),
+                    "Time step (s); 0: half the estimated stable step of each variant.");
+  prm.declare_entry("steps", "2000", Patterns::Integer(1), "Dynamic steps timed.");
+  prm.leave_subsection();
+  prm.enter_subsection("output");
+  prm.declare_entry("directory", "results/runs", Patterns::Anything(),
+                    "Folder under which each run writes <case>-<time>/.");
+  prm.leave_subsection();
+}
+
+void declare_all(ParameterHandler& prm) {
+  declare_geometry(prm);
+  declare_material(prm);
+  declare_support(prm);
+  declare_loads(prm);
+  declare_mass_spring(prm);
+  declare_fem_timing_output(prm);
+}
+
+// deal.II's messages span several indented lines and write "Line <12> of file <a.prm>"; users and
+// scripts get one line in the compiler's "a.prm:12: ..." form.
+std::string one_line(const dealii::ExceptionBase& e) {
+  std::ostringstream info;
+  e.print_info(info);
+  std::string text = std::regex_replace(info.str(), std::regex("\\s+"), " ");
+  // (ExcNoSubsection omits the '>' after the file name.)
+  text = std::regex_replace(text, std::regex("^ *Line <(\\d+)> of file <(.*?)>?: *"), "$2:$1: ");
+  return std::regex_replace(text, std::regex(" +$"), "");
+}
+
+Eigen::Vector3d parse_point(const std::string& text) {
+  Eigen::Vector3d p;
+  const auto parts = Patterns::Tools::Convert<std::vector<double>>::to_value(text, point_pattern());
+  for (int k = 0; k < 3; ++k)
+    p[k] = parts[k];
+  return p;
+}
+
+Eigen::Vector3d unit_vector(const std::string& text, const std::string& key) {
+  const Eigen::Vector3d v = parse_point(text);
+  if (!(v.norm() > 0)) throw InputError(key + ": direction '" + text + "' has zero length");
+  return v.normalized();
+}
+
+void apply_override(ParameterHandler& prm, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos)
+    throw InputError("--set '" + assignment + "': expected SECTION/KEY=VALUE");
+  std::string path = assignment.substr(0, eq);
+  const std::string value = assignment.substr(eq + 1);
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const auto slash = path.find('/', start);
+    parts.push_back(path.substr(start, slash - start));
+    if (slash == std::string::npos) break;
+    start = slash + 1;
+  }
+  const std::string key = parts.back();
+  parts.pop_back();
+  try {
+    for (const auto& section : parts)
+      prm.enter_subsection(section);
+    // get() throws for an undeclared key; set() checks the value against the key's pattern.
+    prm.get(key);
+    prm.set(key, value);
+  } catch (const dealii::ExceptionBase& e) {
+    throw InputError("--set '" + assignment + "': " + one_line(e));
+  }
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    prm.leave_subsection();
+}
+
+CaseParameters extract(ParameterHandler& prm) {
+  CaseParameters c;
+  prm.enter_subsection("geometry");
+  c.geometry.source = prm.get("source");
+  c.geometry.unit = parse_length_unit(prm.get("unit"));
+  c.geometry.simplify_to_vertices = prm.get_integer("simplify to vertices");
+  c.geometry.smoothing_iterations = prm.get_integer("smoothing iterations");
+  prm.leave_subsection();
+
+  prm.enter_subsection("material");
+  c.material = {prm.get_double("youngs modulus"), prm.get_double("poisson ratio"),
+                prm.get_double("density")};
+  prm.leave_subsection();
+  if (!(c.material.youngs_modulus_pa > 0)) throw InputError("material/youngs modulus must be > 0");
+  if (!(c.material.density_kg_per_m3 > 0)) throw InputError("material/density must be > 0");
+
+  prm.enter_subsection("support");
+  const std::string region = prm.get("fixed region");
+  c.support.kind = region == "inner core"   ? SupportParameters::Kind::inner_core
+                   : region == "half space" ? SupportParameters::Kind::half_space
+                                            : SupportParameters::Kind::sphere;
+  c.support.inner_core_scale = prm.get_double("inner core scale");
+  c.support.half_space_point = parse_point(prm.get("half space point"));
+  c.support.half_space_normal =
+      unit_vector(prm.get("half space normal"), "support/half space normal");
+  c.support.sphere_center = parse_point(prm.get("sphere center"));
+  c.support.sphere_radius_m = prm.get_double("sphere radius");
+  prm.leave_subsection();
+  if (c.support.kind == SupportParameters::Kind::inner_core && !(c.support.inner_core_scale > 1.0))
+    throw InputError("support/inner core scale must be > 1");
+  if (c.support.kind == SupportParameters::Kind::sphere && !(c.support.sphere_radius_m > 0))
+    throw InputError("support/sphere radius must be > 0 for a fixed sphere");
+
+  prm.enter_subsection("loads");
+  c.loads.gravity_m_per_s2 = parse_point(prm.get("gravity"));
+  prm.enter_subsection("tool");
+  auto& tool = c.loads.tool;
+  tool.enabled = prm.get_bool("enabled");
+  tool.mode = prm.get("mode") == "contact" ? ToolParameters::Mode::contact
+                                           : ToolParameters::Mode::prescribed;
+  tool.directions.clear();
+  for (const auto& d : dealii::Utilities::split_string_list(prm.get("directions"), ';'))
+    tool.directions.push_back(unit_vector(d, "loads/tool/directions"));
+  tool.radius_m = prm.get_double("radius");
+  tool.depth_m = prm.get_double("depth");
+  for (const auto& d : dealii::Utilities::split_string_list(prm.get("curve depths")))
+    tool.curve_depths_m.push_back(std::stod(d));
+  prm.leave_subsection();
+  if (tool.enabled && !(tool.radius_m > 0 && tool.depth_m > 0))
+    throw InputError("loads/tool: radius and depth must be > 0 when the tool is enabled");
+  prm.enter_subsection("patch force");
+  auto& patch = c.loads.patch_force;
+  patch.enabled = prm.get_bool("enabled");
+  patch.direction = unit_vector(prm.get("direction"), "loads/patch force/direction");
+  patch.radius_m = prm.get_double("radius");
+  patch.force_n = parse_point(prm.get("force"));
+  prm.leave_subsection();
+  prm.leave_subsection();
+
+  prm.enter_subsection("mass spring");
+  auto& ms = c.mass_spring;
+  ms.variants = dealii::Utilities::split_string_list(prm.get("variants"));
+  ms.stiffness_model = prm.get("stiffness model");
+  ms.damping_ratio = prm.get_double("damping ratio");
+  for (const auto& entry : dealii::Utilities::split_string_list(prm.get("group scales"))) {
+    const auto colon = entry.find(':');
+    char* end = nullptr;
+    const double factor =
+        colon == std::string::npos ? 0.0 : std::strtod(entry.c_str() + colon + 1, &end);
+    if (colon == std::string::npos || !end || *end != '\0' || !(factor > 0) ||
+        !std::isfinite(factor))
+      throw InputError("mass spring/group scales: '" + entry +
+                       "' is not GROUP:FACTOR with a positive factor");
+    ms.group_scales.emplace_back(entry.substr(0, colon), factor);
+  }
+  prm.enter_subsection("three tier");
+  ms.middle_tier_scale = prm.get_double("middle tier scale");
+  ms.inner_tier_scale = prm.get_double("inner tier scale");
+  ms.inner_tiers = prm.get("inner tiers");
+  prm.leave_subsection();
+  prm.enter_subsection("skeleton");
+  ms.skeleton_control_points = prm.get_integer("control points");
+  ms.skeleton_draw_factor = prm.get_double("draw factor");
+  prm.leave_subsection();
+  prm.leave_subsection();
+  if (!(ms.inner_tier_scale > ms.middle_tier_scale))
+    throw InputError("mass spring/three tier: inner tier scale must exceed middle tier scale");
+
+  prm.enter_subsection("fem");
+  c.fem = {prm.get_integer("degree"), prm.get_double("cell size"), prm.get("solver"),
+           prm.get_double("relative tolerance")};
+  prm.leave_subsection();
+  prm.enter_subsection("timing");
+  c.timing = {prm.get("integrator"), prm.get_double("dt"), prm.get_integer("steps")};
+  prm.leave_subsection();
+  prm.enter_subsection("output");
+  c.output.directory = prm.get("directory");
+  prm.leave_subsection();
+  return c;
+}
+
+}  // namespace
+
+CaseParameters read_case(const std::filesystem::path& file,
+                         const std::vector<std::string>& overrides) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot open case file");
+  ParameterHandler prm;
+  declare_all(prm);
+  try {
+    prm.parse_input(in, file.string(), "", /*skip_undefined=*/false);
+  } catch (const dealii::ExceptionBase& e) {
+    throw InputError(one_line(e));
+  }
+  for (const auto& o : overrides)
+    apply_override(prm, o);
+  CaseParameters c;
+  try {
+    c = extract(prm);
+  } catch (const InputError& e) {
+    throw InputError(file.string() + ": " + e.what());
+  }
+  c.file = file;
+  c.name = file.stem().string();
+  // A relative surface path is relative to the case file, so cases run from any folder.
+  if (c.geometry.source.find(':') == std::string::npos) {
+    const std::filesystem::path p(c.geometry.source);
+    if (p.is_relative()) c.geometry.source = (file.parent_path() / p).lexically_normal().string();
+  }
+  return c;
+}
+
+std::string describe_case_parameters() {
+  ParameterHandler prm;
+  declare_all(prm);
+  std::ostringstream out;
+  prm.print_parameters(out, ParameterHandler::OutputStyle::PRM);
+  return out.str();
+}
+
+}  // namespace msfem::cases

@@ -1,0 +1,152 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/errors.hpp"
+
+namespace msfem::cases {
+namespace {
+
+class CaseFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("msfem_case_" + std::to_string(std::random_device{}()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::filesystem::path write(const std::string& name, const std::string& text) {
+    const auto p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+
+  // The message of the InputError thrown by read_case, or "" if none was.
+  std::string error_of(const std::filesystem::path& p, const std::vector<std::string>& sets = {}) {
+    try {
+      read_case(p, sets);
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+      return e.what();
+    }
+    return "";
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(CaseFile, ReadsEverySectionAndResolvesTheSurfaceBesideTheCase) {
+  const auto p = write("brainy.prm", R"(# a comment
+subsection geometry
+  set source = meshes/brain.obj
+  set unit = mm
+  set simplify to vertices = 9177
+end
+subsection material
+  set youngs modulus = 1400
+  set poisson ratio = 0.49
+end
+subsection support
+  set fixed region = half space
+  set half space normal = 0, 0, -2
+end
+subsection loads
+  set gravity = 0, 0, -9.81
+  subsection tool
+    set directions = 0,0,1; 1,0,0
+    set depth = 0.004
+    set curve depths = 0.001, 0.002
+  end
+end
+subsection mass spring
+  set variants = three_tier, skeleton
+  set group scales = tier1_edges:1.5, links:0.5
+  subsection three tier
+    set inner tiers = offset
+  end
+end
+subsection fem
+  set degree = 1
+end
+)");
+  const CaseParameters c = read_case(p);
+  EXPECT_EQ(c.name, "brainy");
+  EXPECT_EQ(c.geometry.source, (dir_ / "meshes/brain.obj").string());
+  EXPECT_EQ(c.geometry.unit, LengthUnit::millimetre);
+  EXPECT_EQ(c.geometry.simplify_to_vertices, 9177);
+  EXPECT_DOUBLE_EQ(c.material.youngs_modulus_pa, 1400);
+  EXPECT_DOUBLE_EQ(c.material.poisson_ratio, 0.49);
+  EXPECT_DOUBLE_EQ(c.material.density_kg_per_m3, 1040);  // default
+  EXPECT_EQ(c.support.kind, SupportParameters::Kind::half_space);
+  EXPECT_TRUE(c.support.half_space_normal.isApprox(Eigen::Vector3d(0, 0, -1)));
+  EXPECT_DOUBLE_EQ(c.loads.gravity_m_per_s2.z(), -9.81);
+  ASSERT_EQ(c.loads.tool.directions.size(), 2u);
+  EXPECT_TRUE(c.loads.tool.directions[1].isApprox(Eigen::Vector3d::UnitX()));
+  EXPECT_DOUBLE_EQ(c.loads.tool.depth_m, 0.004);
+  EXPECT_EQ(c.loads.tool.curve_depths_m, (std::vector<double>{0.001, 0.002}));
+  EXPECT_EQ(c.mass_spring.variants, (std::vector<std::string>{"three_tier", "skeleton"}));
+  ASSERT_EQ(c.mass_spring.group_scales.size(), 2u);
+  EXPECT_EQ(c.mass_spring.group_scales[0].first, "tier1_edges");
+  EXPECT_DOUBLE_EQ(c.mass_spring.group_scales[1].second, 0.5);
+  EXPECT_EQ(c.mass_spring.inner_tiers, "offset");
+  EXPECT_EQ(c.fem.degree, 1);
+}
+
+TEST_F(CaseFile, UnknownKeyNamesFileAndLine) {
+  const auto p = write("typo.prm",
+                       "subsection material\n  set youngs modulus = 1\n"
+                       "  set poison ratio = 0.3\nend\n");
+  const std::string e = error_of(p);
+  EXPECT_NE(e.find("typo.prm:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("poison ratio"), std::string::npos) << e;
+}
+
+TEST_F(CaseFile, UnknownSectionAndOutOfRangeValuesNameFileAndLine) {
+  const std::string section = error_of(write("sec.prm", "\nsubsection materials\nend\n"));
+  EXPECT_NE(section.find("sec.prm:2:"), std::string::npos) << section;
+
+  const std::string range =
+      error_of(write("nu.prm", "subsection material\n  set poisson ratio = 0.6\nend\n"));
+  EXPECT_NE(range.find("nu.prm:2:"), std::string::npos) << range;
+  EXPECT_NE(range.find("0.6"), std::string::npos) << range;
+
+  const std::string variant = error_of(
+      write("v.prm", "subsection mass spring\n  set variants = three_tier, four_tier\nend\n"));
+  EXPECT_NE(variant.find("v.prm:2:"), std::string::npos) << variant;
+
+  const std::string zero_e =
+      error_of(write("e.prm", "subsection material\n  set youngs modulus = 0\nend\n"));
+  EXPECT_NE(zero_e.find("youngs modulus"), std::string::npos) << zero_e;
+
+  EXPECT_NE(error_of(dir_ / "absent.prm").find("absent.prm"), std::string::npos);
+}
+
+TEST_F(CaseFile, CommandLineOverridesAreTypedToo) {
+  const auto p = write("base.prm", "subsection material\n  set youngs modulus = 1400\nend\n");
+  const CaseParameters c =
+      read_case(p, {"material/youngs modulus=2500", "loads/tool/depth=0.002", "fem/degree=1"});
+  EXPECT_DOUBLE_EQ(c.material.youngs_modulus_pa, 2500);
+  EXPECT_DOUBLE_EQ(c.loads.tool.depth_m, 0.002);
+  EXPECT_EQ(c.fem.degree, 1);
+
+  EXPECT_NE(error_of(p, {"material/youngs=1"}).find("--set 'material/youngs=1'"),
+            std::string::npos);
+  EXPECT_NE(error_of(p, {"fem/degree=3"}).find("fem/degree=3"), std::string::npos);
+  EXPECT_NE(error_of(p, {"nosuch/key=1"}).find("nosuch"), std::string::npos);
+  EXPECT_NE(error_of(p, {"material/density"}).find("SECTION/KEY=VALUE"), std::string::npos);
+}
+
+TEST(CaseLanguage, DescribesEverySection) {
+  const std::string text = describe_case_parameters();
+  for (const char* s : {"geometry", "material", "support", "loads", "tool", "patch force",
+                        "mass spring", "three tier", "skeleton", "fem", "timing", "output"})
+    EXPECT_NE(text.find("subsection " + std::string(s)), std::string::npos) << s;
+  EXPECT_NE(text.find("youngs modulus"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace msfem::cases
