@@ -20,6 +20,11 @@ struct CommandEntry {
 const std::vector<CommandEntry>& commands() {
   using namespace msfem::compare;
   static const std::vector<CommandEntry> table = {
+      {"run", run_command,
+       "run CASE.prm [--out DIR] [--set SECTION/KEY=VALUE]... [--quiet] [--json] [--no-curve]\n"
+       "      the FEM and every mass-spring variant on the case; summary.json, report.md, VTU, "
+       "HDF5"},
+      {"params", params_command, "params\n      print the whole case-file language"},
       {"mesh-info", mesh_info_command,
        "mesh-info FILE [--unit m|cm|mm] [--json] [--no-self-intersections]\n"
        "            mesh-info --generate icosphere:LEVEL[:RADIUS_M] | ellipsoid:LEVEL:A:B:C\n"

@@ -13,6 +13,8 @@ using Arguments = std::vector<std::string>;
 
 int mesh_info_command(const Arguments& args);  // msfem mesh-info FILE [--unit mm]
 int simplify_command(const Arguments& args);   // msfem simplify IN OUT --vertices N [--smooth K]
+int run_command(const Arguments& args);        // msfem run CASE.prm [--out DIR] [--set K=V]...
+int params_command(const Arguments& args);     // msfem params
 int bench_command(const Arguments& args);      // msfem bench massspring|fem [--json]
 int verify_command(const Arguments& args);     // msfem verify [--json]
 

@@ -39,7 +39,7 @@ class Options {
             throw std::invalid_argument("option --" + key + " needs a value");
           value = args[++i];
         }
-        values_[key] = value;
+        values_[key].push_back(value);
       } else {
         throw std::invalid_argument("unknown option '" + a + "'");
       }
@@ -48,10 +48,16 @@ class Options {
 
   const std::vector<std::string>& positional() const { return positional_; }
   bool flag(const std::string& key) const { return flags_.count(key) > 0; }
+  /// The last value given for --key.
   std::optional<std::string> value(const std::string& key) const {
     const auto it = values_.find(key);
     if (it == values_.end()) return std::nullopt;
-    return it->second;
+    return it->second.back();
+  }
+  /// Every value given for a repeatable option such as --set, in order.
+  std::vector<std::string> values(const std::string& key) const {
+    const auto it = values_.find(key);
+    return it == values_.end() ? std::vector<std::string>{} : it->second;
   }
 
   /// Integer value of --key, or `fallback`; an unparsable or out-of-range value names the option.
@@ -73,7 +79,7 @@ class Options {
  private:
   std::vector<std::string> positional_;
   std::set<std::string> flags_;
-  std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> values_;
 };
 
 }  // namespace msfem::compare

@@ -1,0 +1,23 @@
+#pragma once
+// Result files appear whole or not at all: a run that fails half way (a full disk, a crashed
+// plotting program, an exception in a writer) must not leave a truncated fields.h5 or surface.vtu
+// that a later `msfem regress` or a ParaView session would take for a result.
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+namespace msfem::compare {
+
+/// Calls `write` with a temporary name in the same folder as `path` (`<name>.tmp.<pid>`, so the
+/// final rename stays on one file system and is atomic), then renames the temporary onto `path`,
+/// replacing any file there. If `write` throws or leaves no file, the temporary is removed, `path`
+/// is left as it was, and a std::runtime_error naming `path` is thrown (with the cause's message).
+void write_file_atomically(
+    const std::filesystem::path& path,
+    const std::function<void(const std::filesystem::path& temporary)>& write);
+
+/// write_file_atomically for a text: the whole of `text`, flushed and checked before the rename.
+void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace msfem::compare

@@ -1,0 +1,78 @@
+#pragma once
+// `msfem run`: the FEM once per load and every variant to static equilibrium on the same problem,
+// with errors, forces and timings, gathered for the writers (run_outputs.hpp).
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "msfem/compare/fem_run.hpp"
+#include "msfem/compare/metrics.hpp"
+#include "msfem/compare/problem.hpp"
+#include "msfem/compare/variant_run.hpp"
+
+namespace msfem::compare {
+
+/// Progress lines on stderr ("stage, percent, time left"); silent when quiet.
+class Progress {
+ public:
+  explicit Progress(bool quiet) : quiet_(quiet) {}
+  void stage(const std::string& what) const;
+  /// Item `done` of `total` finished, `elapsed_s` since the stage began.
+  void advance(const std::string& what, int done, int total, double elapsed_s) const;
+
+ private:
+  bool quiet_;
+};
+
+struct ForceDepthPoint {
+  double depth_m = 0.0;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+};
+
+struct VariantResult {
+  std::string name;
+  int nodes = 0, springs = 0;
+  ZonedErrorMetrics errors;
+  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
+  double reaction_force_rel_error = 0.0;
+  double volume_change = 0.0;
+  Timing timing;
+  int newton_iterations = 0;
+  nlohmann::json parameters;  ///< group stiffness, damping, masses as used
+  std::vector<std::string> warnings;
+  Eigen::MatrixX3d surface_displacement;  ///< at the surface vertices, m
+  Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
+  std::vector<ForceDepthPoint> force_depth;
+};
+
+struct CaseRun {
+  Problem problem;
+  fem_reference::VolumeMesh mesh;
+  FemSolution fem;
+  std::vector<ForceDepthPoint> fem_force_depth;
+  std::vector<VariantResult> variants;
+  std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
+  double wall_time_s = 0.0;
+};
+
+struct RunSettings {
+  bool quiet = false;
+  bool force_depth_curve = true;
+  bool time_dynamics = true;
+  /// Where the FEM writes its VTU (the run's folder); none: not written.
+  std::optional<std::filesystem::path> fem_output_directory;
+};
+
+/// Runs the case. Throws cases::InputError for bad input (naming the case file), std::runtime_error
+/// when a solver fails.
+CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& settings);
+
+/// Force-depth depths of a tool: the case's list, or a quarter, half, three quarters and all of it.
+std::vector<double> curve_depths(const cases::ToolParameters& tool);
+
+}  // namespace msfem::compare

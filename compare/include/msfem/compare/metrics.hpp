@@ -1,0 +1,38 @@
+#pragma once
+// Displacement and force errors of a mass-spring model against the FEM reference, as defined in
+// docs/metrics.md (DESIGN's metrics): over the surface vertices not prescribed by a support or
+// load.
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace msfem::compare {
+
+struct ErrorMetrics {
+  double rel_l2_error = 0.0;              ///< ‖u − v‖₂ / ‖v‖₂
+  double rms_error_m = 0.0;               ///< sqrt(mean |u − v|²)
+  double max_error_m = 0.0;               ///< max |u − v|
+  double mean_error_over_max_disp = 0.0;  ///< mean |u − v| / max |v|
+  int vertices = 0;                       ///< how many vertices the figures are over
+};
+
+/// Errors of u (model) against v (reference) over the given rows (n x 3 each, metres). Throws
+/// std::invalid_argument if the arrays differ in shape, a value is not finite, or the reference
+/// does not move at all on those rows (a relative error would be meaningless).
+ErrorMetrics displacement_error(const Eigen::MatrixX3d& u, const Eigen::MatrixX3d& v,
+                                const std::vector<int>& rows);
+
+/// The same, split by distance from the tool: the contact zone is within `zone_radius` of
+/// `tool_point` (DESIGN: 2 r), the far field the rest. An empty zone gives zeros with vertices = 0.
+struct ZonedErrorMetrics {
+  ErrorMetrics all, contact_zone, far_field;
+};
+ZonedErrorMetrics zoned_displacement_error(const Eigen::MatrixX3d& u, const Eigen::MatrixX3d& v,
+                                           const Eigen::MatrixX3d& rest_positions,
+                                           const std::vector<int>& rows,
+                                           const Eigen::Vector3d& tool_point, double zone_radius);
+
+/// |F_ms − F_fem| / |F_fem|; throws std::invalid_argument if the reference force is zero.
+double reaction_force_rel_error(const Eigen::Vector3d& model, const Eigen::Vector3d& reference);
+
+}  // namespace msfem::compare

@@ -1,0 +1,53 @@
+#pragma once
+// A case turned into geometry both models share: the validated surface, the fixed region and the
+// tool placements, each stated once and mapped by each model onto its own nodes.
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/surface.hpp"
+#include "msfem/fem_reference/elasticity_problem.hpp"
+
+namespace msfem::compare {
+
+/// Where a tool presses: the surface vertex farthest from the centroid along the case's direction.
+struct ToolPlacement {
+  int vertex = -1;
+  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d outward_normal = Eigen::Vector3d::UnitZ();  ///< the vertex normal there
+  double radius = 0.0;
+  double depth = 0.0;
+  /// Centre of the sphere at full depth: contact + (radius − depth) n.
+  Eigen::Vector3d pushed_center() const {
+    return contact_point + (radius - depth) * outward_normal;
+  }
+};
+
+struct Problem {
+  cases::CaseParameters parameters;
+  cases::Surface surface;  ///< outward, closed, manifold, metres
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  std::vector<std::string> notes;  ///< what loading changed (orientation fixed, simplified, ...)
+  /// The fixed region as a predicate on positions (the same for both models).
+  std::function<bool(const Eigen::Vector3d&)> fixed_region;
+  std::vector<ToolPlacement> tools;  ///< one per tool direction (empty when the tool is off)
+};
+
+/// Loads and checks the case's surface (generate or read, simplify, smooth, orient) and places its
+/// supports and tools. Throws cases::InputError naming the case file for a surface with defects, a
+/// fixed region or tool that catches no surface node, or a tool deeper than the model.
+Problem make_problem(const cases::CaseParameters& parameters);
+
+/// The tool at a given depth (the force-depth curve uses several).
+ToolPlacement at_depth(ToolPlacement tool, double depth);
+
+/// The tool as prescribed displacement, the same for both models: every surface node inside the
+/// sphere at full depth moves along the push axis onto the sphere's far side, as under a rigid
+/// indenter (a radial projection would push the nodes next to the centre sideways, not down).
+/// Named "tool", on boundary nodes only.
+fem_reference::Support tool_patch_support(const ToolPlacement& tool);
+
+}  // namespace msfem::compare

@@ -1,0 +1,62 @@
+#pragma once
+// One mass-spring variant on a problem: build it, map the shared supports and loads onto its nodes,
+// solve its static equilibrium and time its dynamic stepping.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "msfem/compare/problem.hpp"
+#include "msfem/fem_reference/volume_mesh.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
+
+namespace msfem::compare {
+
+/// The variants a case may name.
+const std::vector<std::string>& known_variants();
+
+/// Builds the variant's network with the case's material and options, and applies the shared
+/// supports, gravity, patch force and (when given) the tool as prescribed displacement of the same
+/// patch the FEM prescribes. `mesh` is the FEM's volume mesh (tet_edges springs its edges). Throws
+/// cases::InputError naming the case key for a bad group name or a variant without supports.
+struct BuiltVariant {
+  std::string name;
+  std::unique_ptr<massspring::MassSpringModel> model;
+  std::vector<int> tool_patch;  ///< nodes the tool prescribes
+  std::vector<std::string> warnings;
+};
+BuiltVariant build_variant(const std::string& name, const Problem& problem,
+                           const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool);
+
+/// Moves the tool of an already built variant to another depth (the force-depth curve).
+void set_tool_depth(BuiltVariant& variant, const Problem& problem, const ToolPlacement& tool);
+
+struct StaticSolution {
+  Eigen::VectorXd x;                                     ///< node-major positions at equilibrium
+  Eigen::MatrixX3d surface_displacement;                 ///< rows in surface vertex order, m
+  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();  ///< force the tissue exerts on the tool
+  int newton_iterations = 0;
+  double solve_time_s = 0.0;
+};
+StaticSolution solve_variant_static(const BuiltVariant& variant);
+
+struct Timing {
+  std::string integrator;
+  double dt_s = 0.0;              ///< step used for steps/s and settling
+  double steps_per_second = 0.0;  ///< median over batches after warm-up
+  double stable_dt_s = 0.0;       ///< largest bounded dt, by bisection
+  double predicted_stable_dt_s = 0.0;
+  double realtime_factor = 0.0;  ///< stable dt × steps/s (simulated s per wall s)
+  double settle_time_s = 0.0;    ///< wall time to within 1 % of equilibrium after the load
+  bool settled = false;
+  double ms_per_60hz_frame = 0.0;
+};
+/// Times the case's integrator on the variant (with its loads), starting from rest, against the
+/// given static equilibrium (for the settle time).
+Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
+                    const Eigen::VectorXd& equilibrium);
+
+}  // namespace msfem::compare

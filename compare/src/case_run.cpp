@@ -1,0 +1,132 @@
+#include "msfem/compare/case_run.hpp"
+
+#include <chrono>
+#include <cstdio>
+
+#include "msfem/cases/errors.hpp"
+
+namespace msfem::compare {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+nlohmann::json variant_parameters(const massspring::MassSpringModel& model) {
+  const auto& n = model.network();
+  nlohmann::json groups = nlohmann::json::object();
+  for (std::size_t g = 0; g < n.spring_group_names.size(); ++g) {
+    double k = 0, d = 0;
+    int count = 0;
+    for (int i = 0; i < n.num_springs(); ++i)
+      if (n.spring_group[i] == static_cast<int>(g)) {
+        k += n.stiffness[i];
+        d += n.damping[i];
+        ++count;
+      }
+    groups[n.spring_group_names[g]] = {{"springs", count},
+                                       {"mean_stiffness_n_per_m", count ? k / count : 0.0},
+                                       {"mean_damping_n_s_per_m", count ? d / count : 0.0}};
+  }
+  return {{"spring_groups", groups},
+          {"total_mass_kg", n.masses.sum()},
+          {"anchors", n.num_anchors()},
+          {"constrained_nodes", model.constrained_nodes().size()}};
+}
+
+}  // namespace
+
+void Progress::stage(const std::string& what) const {
+  if (!quiet_) std::fprintf(stderr, "msfem: %s\n", what.c_str());
+}
+
+void Progress::advance(const std::string& what, int done, int total, double elapsed_s) const {
+  if (quiet_) return;
+  const double left = done > 0 ? elapsed_s / done * (total - done) : 0.0;
+  std::fprintf(stderr, "msfem: %s %d/%d (%.0f %%, %.1f s, about %.0f s left)\n", what.c_str(), done,
+               total, 100.0 * done / total, elapsed_s, left);
+}
+
+std::vector<double> curve_depths(const cases::ToolParameters& tool) {
+  if (!tool.curve_depths_m.empty()) return tool.curve_depths_m;
+  return {0.25 * tool.depth_m, 0.5 * tool.depth_m, 0.75 * tool.depth_m, tool.depth_m};
+}
+
+CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& settings) {
+  const auto start = Clock::now();
+  const Progress progress(settings.quiet);
+  for (const auto& v : parameters.mass_spring.variants) {
+    const auto& known = known_variants();
+    if (std::find(known.begin(), known.end(), v) == known.end())
+      throw cases::InputError(parameters.file.string() +
+                              ": mass spring/variants: unknown variant '" + v + "'");
+  }
+  CaseRun run;
+  progress.stage("loading the surface and placing supports and loads");
+  run.problem = make_problem(parameters);
+  const Problem& problem = run.problem;
+  const std::optional<ToolPlacement> tool =
+      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
+
+  progress.stage("meshing the volume (Gmsh) for the FEM reference");
+  run.mesh = mesh_problem(problem);
+  progress.stage("solving the FEM reference (P" + std::to_string(parameters.fem.degree) + ", " +
+                 std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
+  run.fem = solve_fem(problem, run.mesh, tool, settings.fem_output_directory);
+
+  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
+  for (std::size_t v = 0; v < prescribed.size(); ++v)
+    if (!prescribed[v]) run.compared_vertices.push_back(static_cast<int>(v));
+  if (run.compared_vertices.empty())
+    throw cases::InputError(parameters.file.string() + ": every surface vertex is prescribed");
+
+  std::vector<double> depths;
+  if (tool && settings.force_depth_curve) depths = curve_depths(parameters.loads.tool);
+  const auto curve_start = Clock::now();
+  for (std::size_t i = 0; i < depths.size(); ++i) {
+    const FemSolution s = solve_fem(problem, run.mesh, at_depth(*tool, depths[i]));
+    run.fem_force_depth.push_back({depths[i], s.tool_force});
+    progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
+                     static_cast<int>(depths.size()), seconds_since(curve_start));
+  }
+
+  const auto variants_start = Clock::now();
+  const int total = static_cast<int>(parameters.mass_spring.variants.size());
+  for (int i = 0; i < total; ++i) {
+    const std::string& name = parameters.mass_spring.variants[i];
+    BuiltVariant built = build_variant(name, problem, run.mesh, tool);
+    VariantResult r;
+    r.name = name;
+    r.nodes = built.model->num_nodes();
+    r.springs = built.model->network().num_springs();
+    r.warnings = built.warnings;
+    r.parameters = variant_parameters(*built.model);
+    const StaticSolution s = solve_variant_static(built);
+    r.newton_iterations = s.newton_iterations;
+    r.surface_displacement = s.surface_displacement;
+    r.error = s.surface_displacement - run.fem.surface_displacement;
+    const Eigen::Vector3d zone_center = tool ? tool->contact_point : problem.centroid;
+    const double zone_radius = tool ? 2 * tool->radius : 0.0;
+    r.errors = zoned_displacement_error(s.surface_displacement, run.fem.surface_displacement,
+                                        problem.surface.vertices, run.compared_vertices,
+                                        zone_center, zone_radius);
+    r.tool_force = s.tool_force;
+    if (tool)
+      r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
+    cases::Surface deformed = problem.surface;
+    deformed.vertices += s.surface_displacement;
+    r.volume_change = cases::signed_volume(deformed) / cases::signed_volume(problem.surface) - 1.0;
+    if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
+    for (double depth : depths) {
+      set_tool_depth(built, problem, at_depth(*tool, depth));
+      r.force_depth.push_back({depth, solve_variant_static(built).tool_force});
+    }
+    run.variants.push_back(std::move(r));
+    progress.advance("variant " + name, i + 1, total, seconds_since(variants_start));
+  }
+  run.wall_time_s = seconds_since(start);
+  return run;
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,83 @@
+// msfem run CASE.prm: both models on one problem, and a report a user can read, plot and open.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <iostream>
+
+#include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/errors.hpp"
+#include "msfem/compare/case_run.hpp"
+#include "msfem/compare/commands.hpp"
+#include "msfem/compare/options.hpp"
+#include "msfem/compare/run_outputs.hpp"
+
+namespace msfem::compare {
+namespace {
+
+std::string timestamp() {
+  const std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return text;
+}
+
+}  // namespace
+
+int run_command(const Arguments& args) {
+  const Options opt(args, {"quiet", "json", "no-curve", "no-timing"}, {"out", "set"});
+  if (opt.positional().size() != 1)
+    throw std::invalid_argument(
+        "usage: msfem run CASE.prm [--out DIR] [--set SECTION/KEY=VALUE]...");
+  const cases::CaseParameters parameters = cases::read_case(opt.positional()[0], opt.values("set"));
+
+  const std::filesystem::path final_dir = opt.value("out")
+                                              ? std::filesystem::path(*opt.value("out"))
+                                              : std::filesystem::path(parameters.output.directory) /
+                                                    (parameters.name + "-" + timestamp());
+  if (std::filesystem::exists(final_dir) && !std::filesystem::is_empty(final_dir))
+    throw cases::InputError(final_dir.string() + ": output folder exists and is not empty");
+  // Everything goes to a temporary sibling that is renamed when complete: a failed run leaves no
+  // run folder behind.
+  const std::filesystem::path work_dir =
+      final_dir.string() + ".tmp-" + std::to_string(static_cast<long>(getpid()));
+  std::filesystem::create_directories(work_dir);
+  try {
+    RunSettings settings;
+    settings.quiet = opt.flag("quiet");
+    settings.force_depth_curve = !opt.flag("no-curve");
+    settings.time_dynamics = !opt.flag("no-timing");
+    settings.fem_output_directory = work_dir;
+    const CaseRun run = run_case(parameters, settings);
+    write_run_outputs(run, work_dir);
+    if (std::filesystem::exists(final_dir)) std::filesystem::remove(final_dir);  // empty
+    std::filesystem::create_directories(final_dir.parent_path().empty() ? "."
+                                                                        : final_dir.parent_path());
+    std::filesystem::rename(work_dir, final_dir);
+    if (opt.flag("json")) {
+      std::cout << summary_json(run).dump(2) << '\n';
+    } else {
+      std::cout << "case " << parameters.name << ": " << run.problem.surface.num_vertices()
+                << " surface vertices, FEM " << run.fem.statistics.dofs << " dofs ("
+                << run.fem.statistics.cells << " cells), run took " << run.wall_time_s << " s\n"
+                << variant_table(run) << "results in " << final_dir.string() << "\n";
+    }
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove_all(work_dir, ignored);
+    throw;
+  }
+  return 0;
+}
+
+int params_command(const Arguments& args) {
+  const Options opt(args, {}, {});
+  if (!opt.positional().empty()) throw std::invalid_argument("usage: msfem params");
+  std::cout << "# The msfem case file language (deal.II ParameterHandler syntax). Lengths in m,\n"
+               "# forces in N, stresses in Pa, densities in kg/m^3, times in s.\n"
+            << cases::describe_case_parameters();
+  return 0;
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,109 @@
+#include "msfem/compare/fem_run.hpp"
+
+#include <cmath>
+
+#include "msfem/cases/surface.hpp"
+#include "msfem/fem_reference/supports_and_loads.hpp"
+#include "msfem/fem_reference/surface_mesher.hpp"
+
+namespace msfem::compare {
+namespace {
+
+double mean_edge_length(const cases::Surface& s) {
+  const auto edges = cases::unique_edges(s);
+  double sum = 0;
+  for (const auto& e : edges)
+    sum += (s.vertices.row(e[0]) - s.vertices.row(e[1])).norm();
+  return sum / static_cast<double>(edges.size());
+}
+
+}  // namespace
+
+fem_reference::VolumeMesh mesh_problem(const Problem& problem) {
+  const auto& p = problem.parameters;
+  fem_reference::MeshOptions options;
+  const double edge = mean_edge_length(problem.surface);
+  options.cell_size = p.fem.cell_size_m > 0 ? p.fem.cell_size_m : edge;
+  if (!problem.tools.empty()) {
+    const ToolPlacement& t = problem.tools.front();
+    options.refinement = fem_reference::LocalRefinement{t.contact_point, 2 * t.radius, 2 * t.radius,
+                                                        0.5 * options.cell_size};
+  }
+  return fem_reference::mesh_closed_surface(problem.surface.vertices, problem.surface.triangles,
+                                            options);
+}
+
+std::vector<bool> prescribed_surface_vertices(const Problem& problem,
+                                              const std::optional<ToolPlacement>& tool) {
+  const auto& s = problem.surface;
+  std::vector<bool> prescribed(static_cast<std::size_t>(s.num_vertices()), false);
+  std::optional<fem_reference::Support> tool_support;
+  if (tool) tool_support = tool_patch_support(*tool);
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v) {
+    const Eigen::Vector3d x = s.vertices.row(v).transpose();
+    prescribed[v] = problem.fixed_region(x) || (tool_support && tool_support->region(x));
+  }
+  return prescribed;
+}
+
+FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                      const std::optional<ToolPlacement>& tool,
+                      const std::optional<std::filesystem::path>& output_directory) {
+  const auto& p = problem.parameters;
+  fem_reference::ElasticityModel model;
+  model.degree = static_cast<unsigned>(p.fem.degree);
+  model.material.youngs_modulus = p.material.youngs_modulus_pa;
+  model.material.poisson_ratio = p.material.poisson_ratio;
+  model.material.density = p.material.density_kg_per_m3;
+  model.material.gravity = p.loads.gravity_m_per_s2;
+  model.solver.relative_tolerance = p.fem.relative_tolerance;
+  model.solver.preconditioner = p.fem.solver == "mumps" ? fem_reference::Preconditioner::mumps
+                                : p.fem.solver == "cg_boomeramg"
+                                    ? fem_reference::Preconditioner::boomer_amg
+                                    : fem_reference::Preconditioner::gamg;
+  // The tool first: a node caught by both keeps the tool's displacement.
+  if (tool) model.supports.push_back(tool_patch_support(*tool));
+  model.supports.push_back(fem_reference::fixed_support("fixed", problem.fixed_region));
+
+  const auto& patch = p.loads.patch_force;
+  if (patch.enabled) {
+    Eigen::Index center = 0;
+    ((problem.surface.vertices.rowwise() - problem.centroid.transpose()) * patch.direction)
+        .maxCoeff(&center);
+    const Eigen::Vector3d c = problem.surface.vertices.row(center).transpose();
+    // Spread the total force as a uniform traction over the patch's area on the surface.
+    double patch_area = 0;
+    const auto& s = problem.surface;
+    for (Eigen::Index t = 0; t < s.num_triangles(); ++t) {
+      const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)),
+                            b = s.vertices.row(s.triangles(t, 1)),
+                            d = s.vertices.row(s.triangles(t, 2));
+      if (((a + b + d) / 3 - c).norm() <= patch.radius_m)
+        patch_area += 0.5 * (b - a).cross(d - a).norm();
+    }
+    if (patch_area > 0) {
+      fem_reference::Traction traction;
+      traction.name = "patch";
+      traction.region = fem_reference::ball(c, patch.radius_m);
+      traction.traction = fem_reference::uniform_traction(patch.force_n / patch_area);
+      model.tractions.push_back(traction);
+    }
+  }
+
+  fem_reference::ElasticityProblem fem(mesh, model);
+  fem.run();
+  FemSolution solution;
+  solution.vertex_displacement = fem.vertex_displacements();
+  solution.surface_displacement =
+      solution.vertex_displacement.topRows(problem.surface.num_vertices());
+  if (tool) solution.tool_force = -fem.reaction_force("tool");
+  solution.statistics = fem.statistics();
+  cases::Surface deformed = problem.surface;
+  deformed.vertices += solution.surface_displacement;
+  solution.volume_change =
+      cases::signed_volume(deformed) / cases::signed_volume(problem.surface) - 1.0;
+  if (output_directory) fem.output_results(*output_directory, "fem");
+  return solution;
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,143 @@
+#include "msfem/compare/problem.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface_generators.hpp"
+#include "msfem/cases/surface_io.hpp"
+#include "msfem/cases/surface_simplification.hpp"
+#include "msfem/cases/surface_validation.hpp"
+#include "msfem/fem_reference/supports_and_loads.hpp"
+
+namespace msfem::compare {
+namespace {
+
+bool is_generator(const std::string& source) {
+  return source.rfind("icosphere:", 0) == 0 || source.rfind("ellipsoid:", 0) == 0;
+}
+
+cases::Surface load_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
+  const auto& g = p.geometry;
+  cases::Surface s = is_generator(g.source) ? cases::generate_surface(g.source)
+                                            : cases::read_surface(g.source, g.unit);
+  if (g.simplify_to_vertices > 0 && g.simplify_to_vertices < s.num_vertices()) {
+    const auto before = s.num_vertices();
+    try {
+      s = cases::simplify(s, g.simplify_to_vertices);
+    } catch (const std::exception& e) {
+      throw cases::InputError(p.file.string() + ": geometry/simplify to vertices: " + e.what());
+    }
+    notes.push_back("simplified from " + std::to_string(before) + " to " +
+                    std::to_string(s.num_vertices()) + " vertices");
+  }
+  if (g.smoothing_iterations > 0) cases::smooth_taubin(s, g.smoothing_iterations);
+  const cases::SurfaceReport report = cases::orient_and_validate(s);
+  for (const auto& f : report.fixes)
+    notes.push_back(f);
+  if (!report.ok())
+    throw cases::InputError(p.file.string() + ": surface " + g.source + " is not a valid closed " +
+                            "surface: " + report.defects.front().message);
+  return s;
+}
+
+std::function<bool(const Eigen::Vector3d&)> fixed_region(const cases::CaseParameters& p,
+                                                         const cases::Surface& s,
+                                                         const Eigen::Vector3d& centroid) {
+  using Kind = cases::SupportParameters::Kind;
+  const auto& sp = p.support;
+  switch (sp.kind) {
+    case Kind::inner_core: {
+      const auto inside = fem_reference::inner_core(s.vertices, s.triangles, sp.inner_core_scale);
+      // Nodes exactly on the core's boundary (the layered model's inner tier, skeleton points drawn
+      // to the same scale) count as inside: test a point a hair closer to the centroid.
+      return [inside, centroid](const Eigen::Vector3d& x) {
+        return inside(centroid + (1.0 - 1e-9) * (x - centroid));
+      };
+    }
+    case Kind::half_space:
+      return fem_reference::half_space(sp.half_space_point, sp.half_space_normal);
+    case Kind::sphere:
+      return fem_reference::ball(sp.sphere_center, sp.sphere_radius_m);
+  }
+  throw cases::InputError(p.file.string() + ": unknown support kind");
+}
+
+ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s,
+                         const Eigen::MatrixX3d& normals, const Eigen::Vector3d& centroid,
+                         const Eigen::Vector3d& direction) {
+  Eigen::Index best = 0;
+  ((s.vertices.rowwise() - centroid.transpose()) * direction).maxCoeff(&best);
+  ToolPlacement t;
+  t.vertex = static_cast<int>(best);
+  t.contact_point = s.vertices.row(best).transpose();
+  t.outward_normal = normals.row(best).transpose();
+  t.radius = p.loads.tool.radius_m;
+  t.depth = p.loads.tool.depth_m;
+  const Eigen::Vector3d extent = (cases::bounding_box(s).row(1) - cases::bounding_box(s).row(0));
+  if (t.depth >= 0.5 * extent.minCoeff())
+    throw cases::InputError(p.file.string() + ": loads/tool/depth " + std::to_string(t.depth) +
+                            " m is not small against the model (smallest extent " +
+                            std::to_string(extent.minCoeff()) + " m)");
+  return t;
+}
+
+}  // namespace
+
+fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
+  const Eigen::Vector3d center = tool.pushed_center();
+  const Eigen::Vector3d inward = -tool.outward_normal.normalized();
+  const double r = tool.radius;
+  fem_reference::Support support;
+  support.name = "tool";
+  support.boundary_nodes_only = true;
+  support.region = [center, r](const Eigen::Vector3d& x) { return (x - center).norm() < r; };
+  // Largest t with |x + t n − c| = r: t = −w·n + sqrt((w·n)² − |w|² + r²), w = x − c.
+  support.displacement = [center, inward, r](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    const Eigen::Vector3d w = x - center;
+    const double wn = w.dot(inward);
+    const double t = -wn + std::sqrt(std::max(0.0, wn * wn - w.squaredNorm() + r * r));
+    return t * inward;
+  };
+  return support;
+}
+
+ToolPlacement at_depth(ToolPlacement tool, double depth) {
+  tool.depth = depth;
+  return tool;
+}
+
+Problem make_problem(const cases::CaseParameters& parameters) {
+  Problem problem;
+  problem.parameters = parameters;
+  problem.surface = load_surface(parameters, problem.notes);
+  const cases::Surface& s = problem.surface;
+  problem.centroid = cases::vertex_centroid(s);
+  problem.fixed_region = fixed_region(parameters, s, problem.centroid);
+
+  int fixed_surface_nodes = 0;
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    fixed_surface_nodes += problem.fixed_region(s.vertices.row(v).transpose());
+  if (fixed_surface_nodes == s.num_vertices())
+    throw cases::InputError(parameters.file.string() +
+                            ": support: the fixed region contains the whole surface");
+
+  if (parameters.loads.tool.enabled) {
+    const Eigen::MatrixX3d normals = cases::vertex_normals(s);
+    for (const auto& d : parameters.loads.tool.directions) {
+      ToolPlacement t = place_tool(parameters, s, normals, problem.centroid, d);
+      if (problem.fixed_region(t.contact_point))
+        throw cases::InputError(parameters.file.string() + ": loads/tool: the tool at direction (" +
+                                std::to_string(d.x()) + ", " + std::to_string(d.y()) + ", " +
+                                std::to_string(d.z()) + ") presses on a fixed node");
+      problem.tools.push_back(t);
+    }
+  }
+  if (problem.tools.empty() && !parameters.loads.patch_force.enabled &&
+      !(parameters.loads.gravity_m_per_s2.norm() > 0))
+    throw cases::InputError(parameters.file.string() +
+                            ": loads: no tool, patch force or gravity: nothing deforms the model");
+  return problem;
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,146 @@
+// The files of a run: for scripts (summary.json), for people (report.md with plots), for ParaView
+// (surface_<variant>.vtu + surfaces.pvd, fem.pvd) and for analysis (fields.h5).
+#include "msfem/compare/run_outputs.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+#include "msfem/compare/atomic_file.hpp"
+#include "msfem/compare/plots.hpp"
+#include "msfem/compare/result_writers.hpp"
+
+namespace msfem::compare {
+namespace {
+
+void write_surfaces(const CaseRun& run, const std::filesystem::path& dir) {
+  const auto& s = run.problem.surface;
+  std::vector<std::pair<std::string, std::string>> datasets;
+  write_surface_vtu(dir / "surface_fem.vtu", s.vertices, s.triangles,
+                    {{"displacement", run.fem.surface_displacement}});
+  datasets.emplace_back("surface_fem.vtu", "fem");
+  for (const auto& v : run.variants) {
+    const std::string file = "surface_" + v.name + ".vtu";
+    write_surface_vtu(dir / file, s.vertices, s.triangles,
+                      {{"displacement", v.surface_displacement},
+                       {"fem_displacement", run.fem.surface_displacement},
+                       {"error", v.error},
+                       {"error_magnitude", v.error.rowwise().norm()}});
+    datasets.emplace_back(file, v.name);
+  }
+  write_pvd(dir / "surfaces.pvd", datasets);
+}
+
+void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
+  FemField fem;
+  fem.vertices = run.mesh.vertices;
+  fem.tetrahedra = run.mesh.tetrahedra;
+  fem.displacement = run.fem.vertex_displacement;
+  std::vector<VariantField> variants;
+  for (const auto& v : run.variants)
+    variants.push_back({v.name, v.surface_displacement, v.error});
+  write_fields_h5(dir / "fields.h5", run.problem.surface.vertices, run.problem.surface.triangles,
+                  fem, variants);
+}
+
+// Plots are an addition to the numbers: without gnuplot the report says so instead.
+std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::path& dir) {
+  std::vector<std::string> lines;
+  if (!gnuplot_available()) {
+    lines.push_back("(plots skipped: gnuplot is not installed)");
+    return lines;
+  }
+  std::vector<std::pair<std::string, Eigen::VectorXd>> histogram_series;
+  for (const auto& v : run.variants) {
+    Eigen::VectorXd e(run.compared_vertices.size());
+    for (std::size_t i = 0; i < run.compared_vertices.size(); ++i)
+      e[i] = 1e3 * v.error.row(run.compared_vertices[i]).norm();
+    histogram_series.emplace_back(v.name, e);
+  }
+  if (!histogram_series.empty()) {
+    const auto file = histogram(dir / "error_histogram.png", "Surface error magnitude per variant",
+                                "|u - u_FEM| (mm)", histogram_series, 30);
+    lines.push_back("![error histogram](" + file.filename().string() + ")");
+  }
+  if (!run.fem_force_depth.empty()) {
+    std::vector<Series> series;
+    Series fem{"FEM", {}, {}};
+    for (const auto& p : run.fem_force_depth) {
+      fem.x.push_back(1e3 * p.depth_m);
+      fem.y.push_back(p.force_n.norm());
+    }
+    series.push_back(fem);
+    for (const auto& v : run.variants) {
+      Series s{v.name, {}, {}};
+      for (const auto& p : v.force_depth) {
+        s.x.push_back(1e3 * p.depth_m);
+        s.y.push_back(p.force_n.norm());
+      }
+      series.push_back(s);
+    }
+    const auto file = xy_lines(dir / "force_depth.png", "Tool force against indentation depth",
+                               "depth (mm)", "|F| (N)", series, false, false);
+    lines.push_back("![force-depth curve](" + file.filename().string() + ")");
+  }
+  return lines;
+}
+
+std::string report_markdown(const CaseRun& run, const std::vector<std::string>& plots) {
+  const auto& p = run.problem.parameters;
+  std::ostringstream md;
+  md << "# msfem run: " << p.name << "\n\n"
+     << "- case file: `" << p.file.string() << "`\n"
+     << "- surface: `" << p.geometry.source << "`, " << run.problem.surface.num_vertices()
+     << " vertices, " << run.problem.surface.num_triangles() << " triangles\n"
+     << "- material: E = " << p.material.youngs_modulus_pa
+     << " Pa, ν = " << p.material.poisson_ratio << ", ρ = " << p.material.density_kg_per_m3
+     << " kg/m³\n"
+     << "- FEM: P" << p.fem.degree << ", " << run.fem.statistics.dofs << " dofs, "
+     << run.fem.statistics.cells << " cells, " << run.fem.statistics.iterations << " iterations, "
+     << run.fem.statistics.solve_time_s << " s solve\n"
+     << "- errors over " << run.compared_vertices.size()
+     << " surface vertices not prescribed by a support or the tool\n"
+     << "- git " << git_revision() << ", " << machine_description() << "\n\n";
+  for (const auto& n : run.problem.notes)
+    md << "> note: " << n << "\n";
+  md << "\n## Variants\n\n"
+     << variant_table(run) << "\n"
+     << "rel L2 = ‖u − v‖₂/‖v‖₂ over the compared vertices; force = |tool reaction|; force err = "
+        "|F − F_FEM|/|F_FEM|; steps/s of the `"
+     << p.timing.integrator
+     << "` integrator (median after warm-up); ms/frame = wall ms per 1/60 s "
+        "of simulated time.\n\n";
+  md << "| variant | contact zone rel L2 | far field rel L2 | mean err / max disp | volume change "
+        "| "
+        "settle time s |\n|---|---|---|---|---|---|\n";
+  for (const auto& v : run.variants) {
+    char row[256];
+    std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %.3f%s |\n", v.name.c_str(),
+                  v.errors.contact_zone.rel_l2_error, v.errors.far_field.rel_l2_error,
+                  v.errors.all.mean_error_over_max_disp, v.volume_change, v.timing.settle_time_s,
+                  v.timing.settled ? "" : " (not settled)");
+    md << row;
+  }
+  for (const auto& v : run.variants)
+    for (const auto& w : v.warnings)
+      md << "\n> " << v.name << ": " << w << "\n";
+  md << "\n## Plots\n\n";
+  for (const auto& l : plots)
+    md << l << "\n\n";
+  md << "## Files\n\n- `summary.json`: every number above\n"
+        "- `surfaces.pvd`: the surface of each variant with displacement, error vector and "
+        "magnitude (ParaView)\n- `fem.pvd`: the FEM solution\n"
+        "- `fields.h5`: FEM volume field, per-variant surface displacement and error\n";
+  return md.str();
+}
+
+}  // namespace
+
+void write_run_outputs(const CaseRun& run, const std::filesystem::path& directory) {
+  write_surfaces(run, directory);
+  write_fields(run, directory);
+  const auto plots = write_plots(run, directory);
+  write_text_atomically(directory / "report.md", report_markdown(run, plots));
+  write_text_atomically(directory / "summary.json", summary_json(run).dump(2) + "\n");
+}
+
+}  // namespace msfem::compare

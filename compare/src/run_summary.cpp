@@ -1,0 +1,166 @@
+// The run's numbers as JSON and as a table: the interface users' scripts and CI read.
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "msfem/compare/run_outputs.hpp"
+
+namespace msfem::compare {
+namespace {
+
+nlohmann::json vec(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+nlohmann::json zone(const ErrorMetrics& m) {
+  return {
+      {"rel_l2_error", m.rel_l2_error}, {"max_error_m", m.max_error_m}, {"vertices", m.vertices}};
+}
+
+std::string command_output(const std::string& command) {
+  std::array<char, 256> buffer{};
+  std::string out;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+  if (!pipe) return "";
+  while (fgets(buffer.data(), buffer.size(), pipe.get()))
+    out += buffer.data();
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r'))
+    out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+std::string git_revision() {
+  const std::string source = std::filesystem::path(MSFEM_DEFAULT_CASES_DIR).parent_path().string();
+  const std::string rev =
+      command_output("git -C '" + source + "' describe --always --dirty 2>/dev/null");
+  return rev.empty() ? "unknown" : rev;
+}
+
+std::string machine_description() {
+  std::array<char, 256> host{};
+  gethostname(host.data(), host.size() - 1);
+  std::string cpu = "unknown CPU";
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);)
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  return std::string(host.data()) + ", " + cpu + ", " +
+         std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+}
+
+nlohmann::json summary_json(const CaseRun& run) {
+  const auto& p = run.problem.parameters;
+  const auto& st = run.fem.statistics;
+  nlohmann::json fem = {{"degree", p.fem.degree},
+                        {"dofs", st.dofs},
+                        {"cells", st.cells},
+                        {"vertices", st.vertices},
+                        {"solve_time_s", st.solve_time_s},
+                        {"assemble_time_s", st.assemble_time_s},
+                        {"iterations", st.iterations},
+                        {"solver", p.fem.solver},
+                        {"mpi_ranks", st.mpi_ranks},
+                        {"reaction_force_N", vec(run.fem.tool_force)},
+                        {"volume_change", run.fem.volume_change}};
+  nlohmann::json curve = nlohmann::json::array();
+  for (const auto& pt : run.fem_force_depth)
+    curve.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
+  fem["force_depth"] = curve;
+
+  nlohmann::json variants = nlohmann::json::array();
+  for (const auto& v : run.variants) {
+    nlohmann::json fd = nlohmann::json::array();
+    for (const auto& pt : v.force_depth)
+      fd.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
+    variants.push_back({{"name", v.name},
+                        {"nodes", v.nodes},
+                        {"springs", v.springs},
+                        {"rel_l2_error", v.errors.all.rel_l2_error},
+                        {"rms_error_m", v.errors.all.rms_error_m},
+                        {"max_error_m", v.errors.all.max_error_m},
+                        {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
+                        {"contact_zone", zone(v.errors.contact_zone)},
+                        {"far_field", zone(v.errors.far_field)},
+                        {"reaction_force_N", vec(v.tool_force)},
+                        {"reaction_force_rel_error", v.reaction_force_rel_error},
+                        {"volume_change", v.volume_change},
+                        {"integrator", v.timing.integrator},
+                        {"dt_s", v.timing.dt_s},
+                        {"steps_per_second", v.timing.steps_per_second},
+                        {"stable_dt_s", v.timing.stable_dt_s},
+                        {"predicted_stable_dt_s", v.timing.predicted_stable_dt_s},
+                        {"realtime_factor", v.timing.realtime_factor},
+                        {"settle_time_s", v.timing.settle_time_s},
+                        {"settled", v.timing.settled},
+                        {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
+                        {"newton_iterations", v.newton_iterations},
+                        {"force_depth", fd},
+                        {"warnings", v.warnings},
+                        {"parameters", v.parameters}});
+  }
+  nlohmann::json tools = nlohmann::json::array();
+  for (const auto& t : run.problem.tools)
+    tools.push_back({{"vertex", t.vertex},
+                     {"contact_point_m", vec(t.contact_point)},
+                     {"outward_normal", vec(t.outward_normal)},
+                     {"radius_m", t.radius},
+                     {"depth_m", t.depth}});
+  return {{"case", p.name},
+          {"case_file", p.file.string()},
+          {"git_revision", git_revision()},
+          {"machine", machine_description()},
+          {"units", {{"length", "m"}, {"force", "N"}, {"time", "s"}, {"stress", "Pa"}}},
+          {"material",
+           {{"youngs_modulus_pa", p.material.youngs_modulus_pa},
+            {"poisson_ratio", p.material.poisson_ratio},
+            {"density_kg_per_m3", p.material.density_kg_per_m3}}},
+          {"surface",
+           {{"source", p.geometry.source},
+            {"vertices", run.problem.surface.num_vertices()},
+            {"triangles", run.problem.surface.num_triangles()}}},
+          {"compared_vertices", run.compared_vertices.size()},
+          {"tools", tools},
+          {"notes", run.problem.notes},
+          {"fem", fem},
+          {"variants", variants},
+          {"wall_time_s", run.wall_time_s}};
+}
+
+std::string variant_table(const CaseRun& run) {
+  std::ostringstream out;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "| %-12s | %6s | %7s | %9s | %9s | %9s | %9s | %10s | %9s | %9s |\n", "variant",
+                "nodes", "springs", "rel L2", "max err mm", "force N", "force err", "steps/s",
+                "stable dt", "ms/frame");
+  out << line;
+  out << "|--------------|--------|---------|-----------|-----------|-----------|-----------|------"
+         "------|-----------|-----------|\n";
+  std::snprintf(line, sizeof line,
+                "| %-12s | %6zu | %7s | %9s | %9s | %9.4g | %9s | %10s | %9s | %9s |\n",
+                ("FEM P" + std::to_string(run.problem.parameters.fem.degree)).c_str(),
+                static_cast<std::size_t>(run.fem.statistics.vertices), "-", "-", "-",
+                run.fem.tool_force.norm(), "-", "-", "-", "-");
+  out << line;
+  for (const auto& v : run.variants) {
+    std::snprintf(
+        line, sizeof line,
+        "| %-12s | %6d | %7d | %9.4f | %9.4f | %9.4g | %9.4f | %10.0f | %9.3g | %9.3f |\n",
+        v.name.c_str(), v.nodes, v.springs, v.errors.all.rel_l2_error,
+        1e3 * v.errors.all.max_error_m, v.tool_force.norm(), v.reaction_force_rel_error,
+        v.timing.steps_per_second, v.timing.stable_dt_s, v.timing.ms_per_60hz_frame);
+    out << line;
+  }
+  return out.str();
+}
+
+}  // namespace msfem::compare

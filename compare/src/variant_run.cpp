@@ -1,0 +1,262 @@
+#include "msfem/compare/variant_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface_simplification.hpp"
+#include "msfem/fem_reference/supports_and_loads.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/stability.hpp"
+#include "msfem/massspring/static_solver.hpp"
+#include "msfem/massspring/surface_geometry.hpp"
+#include "msfem/massspring/tool_contact.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+
+namespace msfem::compare {
+namespace {
+
+namespace ms = msfem::massspring;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+ms::SpringNetwork build_network(const std::string& name, const Problem& problem,
+                                const fem_reference::VolumeMesh& mesh) {
+  const auto& p = problem.parameters;
+  const auto& s = problem.surface;
+  ms::Material material;
+  material.youngs_modulus = p.material.youngs_modulus_pa;
+  material.density = p.material.density_kg_per_m3;
+  if (name == "three_tier") {
+    ms::ThreeTierOptions o;
+    o.inner_tiers = p.mass_spring.inner_tiers == "offset" ? ms::InnerTierMethod::normal_offset
+                                                          : ms::InnerTierMethod::scaling;
+    o.tier2_scale = p.mass_spring.middle_tier_scale;
+    o.tier3_scale = p.mass_spring.inner_tier_scale;
+    o.material = material;
+    return ms::build_three_tier(s.vertices, s.triangles, o);
+  }
+  if (name == "single_layer") {
+    ms::SingleLayerOptions o;
+    // Tied to rest only where no surface node is supported (as simulators do).
+    o.anchor_to_rest = true;
+    for (Eigen::Index v = 0; v < s.num_vertices() && o.anchor_to_rest; ++v)
+      o.anchor_to_rest = !problem.fixed_region(s.vertices.row(v).transpose());
+    o.material = material;
+    return ms::build_single_layer(s.vertices, s.triangles, o);
+  }
+  if (name == "tet_edges") {
+    ms::TetEdgesOptions o;
+    o.stiffness_rule = p.mass_spring.stiffness_model == "van_gelder"
+                           ? ms::TetStiffnessRule::van_gelder
+                           : ms::TetStiffnessRule::lloyd;
+    o.material = material;
+    const Eigen::MatrixX4i tets = mesh.tetrahedra;
+    return ms::build_tet_edges(mesh.vertices, tets, o);
+  }
+  if (name == "skeleton") {
+    const int wanted = p.mass_spring.skeleton_control_points > 0
+                           ? p.mass_spring.skeleton_control_points
+                           : std::max(20, static_cast<int>(s.num_vertices() / 10));
+    const cases::Surface control = cases::simplify(s, std::min<int>(wanted, s.num_vertices()));
+    ms::SkeletonOptions o;
+    o.control_scale = p.mass_spring.skeleton_draw_factor;
+    o.material = material;
+    return ms::build_skeleton(s.vertices, s.triangles, control.vertices, control.triangles, o);
+  }
+  throw cases::InputError(p.file.string() + ": mass spring/variants: unknown variant '" + name +
+                          "'");
+}
+
+// Damping of each spring as a fraction of critical for the two-body oscillator it forms.
+void set_damping_ratio(ms::MassSpringModel& model, double ratio) {
+  const auto& n = model.network();
+  Eigen::VectorXd damping(n.num_springs());
+  for (int i = 0; i < n.num_springs(); ++i) {
+    const double ma = n.masses[n.springs(i, 0)], mb = n.masses[n.springs(i, 1)];
+    damping[i] = 2.0 * ratio * std::sqrt(n.stiffness[i] * ma * mb / (ma + mb));
+  }
+  model.set_damping(damping);
+}
+
+void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
+  const auto& patch = problem.parameters.loads.patch_force;
+  if (!patch.enabled) return;
+  const auto& s = problem.surface;
+  Eigen::Index center = 0;
+  ((s.vertices.rowwise() - problem.centroid.transpose()) * patch.direction).maxCoeff(&center);
+  const Eigen::VectorXd areas = ms::vertex_areas(s.vertices, s.triangles);
+  std::vector<int> nodes;
+  double total_area = 0;
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    if ((s.vertices.row(v) - s.vertices.row(center)).norm() <= patch.radius_m) {
+      nodes.push_back(static_cast<int>(v));
+      total_area += areas[v];
+    }
+  const auto& surface_nodes = model.network().surface_nodes;
+  for (int v : nodes)
+    model.set_external_force(surface_nodes[v], patch.force_n * areas[v] / total_area);
+}
+
+}  // namespace
+
+const std::vector<std::string>& known_variants() {
+  static const std::vector<std::string> names = {"three_tier", "single_layer", "tet_edges",
+                                                 "skeleton"};
+  return names;
+}
+
+void set_tool_depth(BuiltVariant& variant, const Problem& problem, const ToolPlacement& tool) {
+  const fem_reference::Support support = tool_patch_support(tool);
+  ms::MassSpringModel& model = *variant.model;
+  for (int node : variant.tool_patch)
+    model.release_node(node);
+  variant.tool_patch.clear();
+  // The very same patch and displacement as the FEM's tool support, node for node.
+  const auto& surface_nodes = model.network().surface_nodes;
+  for (Eigen::Index v = 0; v < problem.surface.num_vertices(); ++v) {
+    const Eigen::Vector3d x = problem.surface.vertices.row(v).transpose();
+    if (!support.region(x)) continue;
+    model.prescribe_displacement(surface_nodes[v], support.displacement(x));
+    variant.tool_patch.push_back(surface_nodes[v]);
+  }
+  // Supports win over the tool where both catch a node (as in the FEM, where the fixed region is
+  // listed after the tool but a tool on a fixed node is refused by make_problem).
+}
+
+BuiltVariant build_variant(const std::string& name, const Problem& problem,
+                           const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool) {
+  const auto& p = problem.parameters;
+  BuiltVariant variant;
+  variant.name = name;
+  try {
+    ms::SpringNetwork network = build_network(name, problem, mesh);
+    variant.warnings = network.warnings;
+    variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
+    ms::MassSpringModel& model = *variant.model;
+    const auto& rest = model.network().rest_positions;
+    for (int node = 0; node < model.num_nodes(); ++node)
+      if (problem.fixed_region(rest.row(node).transpose())) model.fix_node(node);
+    for (const auto& [group, factor] : p.mass_spring.group_scales) {
+      if (std::find(model.network().spring_group_names.begin(),
+                    model.network().spring_group_names.end(),
+                    group) == model.network().spring_group_names.end())
+        continue;  // a group of another variant
+      model.scale_group_stiffness(group, factor);
+    }
+    if (model.constrained_nodes().empty() && model.network().num_anchors() == 0)
+      throw cases::InputError(p.file.string() + ": variant " + name +
+                              ": no node lies in the fixed region and nothing anchors it, so it "
+                              "would float away (adjust the support or the variant's geometry)");
+    set_damping_ratio(model, p.mass_spring.damping_ratio);
+    model.set_gravity(p.loads.gravity_m_per_s2);
+    apply_patch_force(model, problem);
+    if (tool) set_tool_depth(variant, problem, *tool);
+  } catch (const ms::ModelError& e) {
+    throw cases::InputError(p.file.string() + ": variant " + name + ": " + e.what());
+  }
+  return variant;
+}
+
+StaticSolution solve_variant_static(const BuiltVariant& variant) {
+  const ms::MassSpringModel& model = *variant.model;
+  const auto start = Clock::now();
+  const ms::StaticResult r = ms::solve_static(model);
+  StaticSolution solution;
+  solution.solve_time_s = seconds_since(start);
+  if (!r.converged)
+    throw std::runtime_error("variant " + variant.name + ": Newton did not converge in " +
+                             std::to_string(r.iterations) + " iterations (residual " +
+                             std::to_string(r.residual_norm) + " N)");
+  solution.x = r.x;
+  solution.newton_iterations = r.iterations;
+  solution.surface_displacement = model.surface_displacement(r.x);
+  if (!variant.tool_patch.empty())
+    solution.tool_force = ms::patch_reaction_force(model, r.x, variant.tool_patch);
+  return solution;
+}
+
+Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
+                    const Eigen::VectorXd& equilibrium) {
+  const ms::MassSpringModel& model = *variant.model;
+  const ms::IntegratorKind kind = ms::parse_integrator(timing.integrator);
+  Timing t;
+  t.integrator = timing.integrator;
+  const ms::State start = ms::initial_state(model);
+  t.predicted_stable_dt_s = ms::predicted_stable_dt(model, kind, start.x);
+  if (kind == ms::IntegratorKind::implicit_euler || !std::isfinite(t.predicted_stable_dt_s)) {
+    // Unconditionally stable: report the step a haptic loop would use (1 kHz).
+    t.stable_dt_s = 1e-3;
+  } else {
+    const double guess = t.predicted_stable_dt_s;
+    t.stable_dt_s = ms::measure_stable_dt(model, kind, 0.25 * guess, 4.0 * guess, 400, 0.02);
+  }
+  t.dt_s = timing.dt_s > 0 ? timing.dt_s : 0.5 * t.stable_dt_s;
+
+  // The real-time path: the fast stepper for symplectic Euler (it has no tool contact, but the
+  // prescribed patch is a support it honours); the generic integrator otherwise.
+  const bool fast = kind == ms::IntegratorKind::symplectic_euler;
+  std::unique_ptr<ms::FastExplicitStepper> stepper;
+  ms::Integrator integrator(kind);
+  ms::State state = start;
+  if (fast) {
+    stepper = std::make_unique<ms::FastExplicitStepper>(model);
+    stepper->set_state(start);
+  }
+  auto advance = [&](int count) {
+    if (fast) {
+      stepper->step(t.dt_s, count);
+    } else {
+      for (int i = 0; i < count; ++i)
+        integrator.step(model, state, t.dt_s);
+    }
+  };
+  auto current = [&]() { return fast ? stepper->state() : state; };
+
+  // Settling, from rest with the load applied: checked every `stride` steps.
+  const Eigen::VectorXd x_rest = start.x;
+  const double travel = (equilibrium - x_rest).norm();
+  const int stride = 20;
+  const double wall_limit_s = 20.0;
+  const auto settle_start = Clock::now();
+  while (seconds_since(settle_start) < wall_limit_s) {
+    advance(stride);
+    const ms::State s = current();
+    if (!s.x.allFinite())
+      throw ms::DivergenceError("variant " + variant.name + " diverged while settling at dt " +
+                                    std::to_string(t.dt_s) + " s (stable dt " +
+                                    std::to_string(t.stable_dt_s) + " s)",
+                                t.dt_s, t.stable_dt_s);
+    if ((s.x - equilibrium).norm() <= 0.01 * travel) {
+      t.settled = true;
+      break;
+    }
+  }
+  t.settle_time_s = seconds_since(settle_start);
+
+  // Speed: median of batches after a warm-up.
+  const int batches = 5;
+  const int per_batch = std::max(1, timing.steps / batches);
+  advance(std::max(1, per_batch / 4));
+  std::vector<double> rates;
+  for (int b = 0; b < batches; ++b) {
+    const auto batch_start = Clock::now();
+    advance(per_batch);
+    rates.push_back(per_batch / std::max(seconds_since(batch_start), 1e-9));
+  }
+  std::sort(rates.begin(), rates.end());
+  t.steps_per_second = rates[rates.size() / 2];
+  t.realtime_factor = t.stable_dt_s * t.steps_per_second;
+  t.ms_per_60hz_frame = 1000.0 * (1.0 / 60.0) / t.dt_s / t.steps_per_second;
+  return t;
+}
+
+}  // namespace msfem::compare
