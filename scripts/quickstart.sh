@@ -5,4 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
-./build/compare/msfem mesh-info --generate icosphere:3:0.05
+./build/compare/msfem run cases/sphere_indent.prm

@@ -9,7 +9,8 @@ namespace {
 
 std::vector<int> all_rows(Eigen::Index n) {
   std::vector<int> r(static_cast<std::size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) r[i] = static_cast<int>(i);
+  for (Eigen::Index i = 0; i < n; ++i)
+    r[i] = static_cast<int>(i);
   return r;
 }
 

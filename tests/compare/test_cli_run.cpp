@@ -1,0 +1,171 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "cli_runner.hpp"
+#include "msfem/compare/result_writers.hpp"
+
+namespace msfem {
+namespace {
+
+using testing::count_lines;
+using testing::read_text;
+using testing::run_msfem;
+using testing::TemporaryDirectory;
+
+const std::string small_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm";
+
+void expect_finite_numbers(const nlohmann::json& j, const std::string& where) {
+  if (j.is_number()) {
+    EXPECT_TRUE(std::isfinite(j.get<double>())) << where;
+  } else if (j.is_object()) {
+    for (const auto& [k, v] : j.items())
+      expect_finite_numbers(v, where + "/" + k);
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i)
+      expect_finite_numbers(j[i], where + "/" + std::to_string(i));
+  }
+}
+
+// One run shared by the checks below (a few seconds).
+class RunSmallSphere : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new TemporaryDirectory();
+    result_ = new testing::CommandResult(
+        run_msfem("run " + small_case + " --quiet --out " + (dir_->path() / "run").string()));
+  }
+  static void TearDownTestSuite() {
+    delete result_;
+    delete dir_;
+  }
+  static std::filesystem::path run_dir() { return dir_->path() / "run"; }
+  static TemporaryDirectory* dir_;
+  static testing::CommandResult* result_;
+};
+TemporaryDirectory* RunSmallSphere::dir_ = nullptr;
+testing::CommandResult* RunSmallSphere::result_ = nullptr;
+
+TEST_F(RunSmallSphere, SummaryHasTheDocumentedSchemaAndFiniteNumbers) {
+  ASSERT_EQ(result_->exit_code, 0) << result_->err;
+  EXPECT_NE(result_->out.find("| three_tier"), std::string::npos) << result_->out;
+  const auto j = nlohmann::json::parse(read_text(run_dir() / "summary.json"));
+  for (const char* key : {"case", "git_revision", "machine", "units", "fem", "variants"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key :
+       {"degree", "dofs", "cells", "solve_time_s", "iterations", "reaction_force_N"})
+    EXPECT_TRUE(j["fem"].contains(key)) << key;
+  ASSERT_EQ(j["variants"].size(), 4u);
+  for (const auto& v : j["variants"]) {
+    for (const char* key :
+         {"name", "nodes", "springs", "rel_l2_error", "rms_error_m", "max_error_m",
+          "mean_error_over_max_disp", "contact_zone", "far_field", "reaction_force_N",
+          "reaction_force_rel_error", "volume_change", "steps_per_second", "stable_dt_s",
+          "realtime_factor", "settle_time_s", "ms_per_60hz_frame", "parameters"})
+      EXPECT_TRUE(v.contains(key)) << v["name"] << " lacks " << key;
+    for (const char* zone : {"contact_zone", "far_field"}) {
+      EXPECT_TRUE(v[zone].contains("rel_l2_error"));
+      EXPECT_TRUE(v[zone].contains("max_error_m"));
+    }
+    EXPECT_GT(v["steps_per_second"].get<double>(), 0.0);
+    EXPECT_GT(v["stable_dt_s"].get<double>(), 0.0);
+  }
+  expect_finite_numbers(j, "summary");
+  EXPECT_EQ(j["variants"][0]["nodes"], 3 * 162);  // three tiers of the level-2 icosphere
+}
+
+TEST_F(RunSmallSphere, PrescribedPatchMovesIdenticallyInBothModels) {
+  ASSERT_EQ(result_->exit_code, 0) << result_->err;
+  const auto h5 = run_dir() / "fields.h5";
+  const Eigen::MatrixXd fem = compare::read_h5_matrix(h5, "/fem/displacement");
+  const auto j = nlohmann::json::parse(read_text(run_dir() / "summary.json"));
+  const int pole = j["tools"][0]["vertex"];
+  EXPECT_NEAR(fem.row(pole).norm(), 0.004, 1e-12);  // pushed the full depth
+  for (const char* v : {"three_tier", "single_layer", "tet_edges", "skeleton"}) {
+    const Eigen::MatrixXd ms =
+        compare::read_h5_matrix(h5, std::string("/variants/") + v + "/displacement");
+    EXPECT_LT((ms.row(pole) - fem.row(pole)).norm(), 1e-15) << v;  // the same function, rounding
+  }
+}
+
+TEST_F(RunSmallSphere, VtuAndHdf5ReadBackConsistently) {
+  ASSERT_EQ(result_->exit_code, 0) << result_->err;
+  const std::string vtu = read_text(run_dir() / "surface_three_tier.vtu");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(vtu, m, std::regex("NumberOfPoints=\"(\\d+)\"")));
+  EXPECT_EQ(std::stoi(m[1]), 162);
+  ASSERT_TRUE(std::regex_search(vtu, m, std::regex("NumberOfCells=\"(\\d+)\"")));
+  EXPECT_EQ(std::stoi(m[1]), 320);
+  const Eigen::MatrixXd err =
+      compare::read_h5_matrix(run_dir() / "fields.h5", "/variants/three_tier/error");
+  const Eigen::MatrixXd u =
+      compare::read_h5_matrix(run_dir() / "fields.h5", "/variants/three_tier/displacement");
+  const Eigen::MatrixXd fem_surface =
+      compare::read_h5_matrix(run_dir() / "fields.h5", "/fem/displacement").topRows(162);
+  EXPECT_LT((err - (u - fem_surface)).norm(), 1e-15);
+  for (const char* f : {"report.md", "surfaces.pvd", "fem.pvd"})
+    EXPECT_TRUE(std::filesystem::exists(run_dir() / f)) << f;
+}
+
+TEST_F(RunSmallSphere, SpringNetworkBeatsSingleLayerAtCauchyPoissonRatio) {
+  // ν = 0.25: a volumetric spring network can represent the material; a membrane cannot.
+  ASSERT_EQ(result_->exit_code, 0) << result_->err;
+  const auto j = nlohmann::json::parse(read_text(run_dir() / "summary.json"));
+  double tet = 0, single = 0;
+  for (const auto& v : j["variants"]) {
+    if (v["name"] == "tet_edges") tet = v["rel_l2_error"];
+    if (v["name"] == "single_layer") single = v["rel_l2_error"];
+  }
+  EXPECT_LT(tet, single);
+  // And the FEM force grows with depth.
+  const auto& curve = j["fem"]["force_depth"];
+  ASSERT_EQ(curve.size(), 2u);
+  EXPECT_GT(curve[1]["force_N"][2].get<double>(), curve[0]["force_N"][2].get<double>());
+}
+
+TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
+  TemporaryDirectory tmp;
+  const std::string base = read_text(small_case);
+  auto write_case = [&](const std::string& name, const std::string& text) {
+    std::ofstream(tmp / name) << text;
+    return (tmp / name).string();
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {write_case("typo.prm", base + "subsection fem\n  set degre = 2\nend\n"), "typo.prm:35:"},
+      {write_case("range.prm", base + "subsection material\n  set poisson ratio = 0.7\nend\n"),
+       "range.prm:35:"},
+      {write_case("mesh.prm", "subsection geometry\n  set source = nowhere.obj\nend\n"),
+       "nowhere.obj"},
+      {write_case("fixedtool.prm", base + "subsection support\n  set fixed region = half space\n"
+                                          "  set half space point = 0,0,0.04\n"
+                                          "  set half space normal = 0,0,1\nend\n"),
+       "fixed node"},
+      {(tmp / "absent.prm").string(), "absent.prm"},
+  };
+  for (const auto& [file, named] : cases) {
+    const auto out = tmp / "out";
+    const auto r = run_msfem("run " + file + " --quiet --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << file << ": " << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << file;
+    for (const auto& entry : std::filesystem::directory_iterator(tmp.path()))
+      EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+  const auto bad_set = run_msfem("run " + small_case + " --quiet --out " + (tmp / "o").string() +
+                                 " --set 'mass spring/variants=four_tier'");
+  EXPECT_EQ(bad_set.exit_code, 2);
+  EXPECT_NE(bad_set.err.find("four_tier"), std::string::npos) << bad_set.err;
+}
+
+TEST(CliParams, PrintsTheWholeLanguage) {
+  const auto r = run_msfem("params");
+  ASSERT_EQ(r.exit_code, 0);
+  for (const char* s : {"subsection geometry", "youngs modulus", "subsection tool", "variants"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+}
+
+}  // namespace
+}  // namespace msfem
