@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/compare/fem_cache.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -69,27 +70,43 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   const std::optional<ToolPlacement> tool =
       problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
 
-  progress.stage("meshing the volume (Gmsh) for the FEM reference");
-  run.mesh = mesh_problem(problem);
-  progress.stage("solving the FEM reference (P" + std::to_string(parameters.fem.degree) + ", " +
-                 std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
-  run.fem = solve_fem(problem, run.mesh, tool, settings.fem_output_directory);
+  std::vector<double> depths;
+  if (tool && settings.force_depth_curve) depths = curve_depths(parameters.loads.tool);
+  run.fem_cache_key = fem_cache_key(problem, depths);
+  std::optional<FemCacheEntry> cached;
+  if (settings.fem_cache_directory)
+    cached = load_fem_cache(*settings.fem_cache_directory, run.fem_cache_key);
+  if (cached) {
+    progress.stage("FEM reference from the cache (" +
+                   (*settings.fem_cache_directory / (run.fem_cache_key + ".cbor")).string() +
+                   "): nothing it depends on changed");
+    run.mesh = std::move(cached->mesh);
+    run.fem = std::move(cached->solution);
+    run.fem_force_depth = std::move(cached->force_depth);
+    run.fem_from_cache = true;
+  } else {
+    progress.stage("meshing the volume (Gmsh) for the FEM reference");
+    run.mesh = mesh_problem(problem);
+    progress.stage("solving the FEM reference (P" + std::to_string(parameters.fem.degree) + ", " +
+                   std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
+    run.fem = solve_fem(problem, run.mesh, tool);
+    const auto curve_start = Clock::now();
+    for (std::size_t i = 0; i < depths.size(); ++i) {
+      const FemSolution s = solve_fem(problem, run.mesh, at_depth(*tool, depths[i]));
+      run.fem_force_depth.push_back({depths[i], s.tool_force});
+      progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
+                       static_cast<int>(depths.size()), seconds_since(curve_start));
+    }
+    if (settings.fem_cache_directory)
+      store_fem_cache(*settings.fem_cache_directory, run.fem_cache_key,
+                      {run.mesh, run.fem, run.fem_force_depth});
+  }
 
   const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
   for (std::size_t v = 0; v < prescribed.size(); ++v)
     if (!prescribed[v]) run.compared_vertices.push_back(static_cast<int>(v));
   if (run.compared_vertices.empty())
     throw cases::InputError(parameters.file.string() + ": every surface vertex is prescribed");
-
-  std::vector<double> depths;
-  if (tool && settings.force_depth_curve) depths = curve_depths(parameters.loads.tool);
-  const auto curve_start = Clock::now();
-  for (std::size_t i = 0; i < depths.size(); ++i) {
-    const FemSolution s = solve_fem(problem, run.mesh, at_depth(*tool, depths[i]));
-    run.fem_force_depth.push_back({depths[i], s.tool_force});
-    progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
-                     static_cast<int>(depths.size()), seconds_since(curve_start));
-  }
 
   const auto variants_start = Clock::now();
   const int total = static_cast<int>(parameters.mass_spring.variants.size());

@@ -26,7 +26,7 @@ std::string timestamp() {
 }  // namespace
 
 int run_command(const Arguments& args) {
-  const Options opt(args, {"quiet", "json", "no-curve", "no-timing"}, {"out", "set"});
+  const Options opt(args, {"quiet", "json", "no-curve", "no-timing", "no-cache"}, {"out", "set"});
   if (opt.positional().size() != 1)
     throw std::invalid_argument(
         "usage: msfem run CASE.prm [--out DIR] [--set SECTION/KEY=VALUE]...");
@@ -48,7 +48,9 @@ int run_command(const Arguments& args) {
     settings.quiet = opt.flag("quiet");
     settings.force_depth_curve = !opt.flag("no-curve");
     settings.time_dynamics = !opt.flag("no-timing");
-    settings.fem_output_directory = work_dir;
+    if (!opt.flag("no-cache"))
+      settings.fem_cache_directory =
+          std::filesystem::path(parameters.output.directory) / ".fem-cache";
     const CaseRun run = run_case(parameters, settings);
     write_run_outputs(run, work_dir);
     if (std::filesystem::exists(final_dir)) std::filesystem::remove(final_dir);  // empty

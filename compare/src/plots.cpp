@@ -18,10 +18,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 #include "msfem/compare/atomic_file.hpp"
 
@@ -290,11 +290,13 @@ std::vector<ParetoPoint> pareto_front(std::vector<ParetoPoint> points) {
   return front;
 }
 
-// A data file column holding a label: double-quoted, so a double quote inside becomes a single one.
+// A data file column holding a label: double-quoted, so a double quote inside becomes a single one;
+// a line break would end the record, a tab would show as a gap.
 std::string label_column(const std::string& label) {
   std::string out = label;
   std::replace(out.begin(), out.end(), '"', '\'');
-  std::replace(out.begin(), out.end(), '\n', ' ');
+  for (char& c : out)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
   return "\"" + out + "\"";
 }
 

@@ -28,6 +28,10 @@ void write_surfaces(const CaseRun& run, const std::filesystem::path& dir) {
     datasets.emplace_back(file, v.name);
   }
   write_pvd(dir / "surfaces.pvd", datasets);
+  // The FEM volume with its vertex displacements (for P2 the edge-midpoint values are left out).
+  write_volume_vtu(dir / "fem.vtu", run.mesh.vertices, run.mesh.tetrahedra,
+                   {{"displacement", run.fem.vertex_displacement}});
+  write_pvd(dir / "fem.pvd", {{"fem.vtu", "fem"}});
 }
 
 void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
@@ -99,6 +103,8 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
      << run.fem.statistics.solve_time_s << " s solve\n"
      << "- errors over " << run.compared_vertices.size()
      << " surface vertices not prescribed by a support or the tool\n"
+     << "- FEM result " << (run.fem_from_cache ? "reused from the cache" : "computed") << " (key "
+     << run.fem_cache_key << ")\n"
      << "- git " << git_revision() << ", " << machine_description() << "\n\n";
   for (const auto& n : run.problem.notes)
     md << "> note: " << n << "\n";

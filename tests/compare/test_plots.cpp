@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -129,6 +130,29 @@ TEST_F(Plots, ReplacesAnEarlierPlot) {
   const fs::path path = dir_ / "pareto.png";
   std::ofstream(path) << "stale";
   expect_picture(pareto(path, "again", {{"a", 100, 0.1}, {"b", 2000, 0.3}}));
+}
+
+// A gnuplot that fails (here a stand-in found first on PATH) is reported with its own message, and
+// leaves no picture and no temporary behind.
+TEST_F(Plots, GnuplotFailureCarriesItsMessage) {
+  REQUIRE_GNUPLOT();  // also fixes gnuplot_available()'s answer before PATH changes
+  const fs::path bin = dir_ / "bin";
+  fs::create_directories(bin);
+  std::ofstream(bin / "gnuplot") << "#!/bin/sh\necho 'line 3: simulated failure' >&2\nexit 1\n";
+  fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+  const std::string old_path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", (bin.string() + ":" + old_path).c_str(), 1);
+  const fs::path svg = dir_ / "out" / "pareto.svg";  // SVG: no terminal probe through the stand-in
+  fs::create_directories(svg.parent_path());
+  try {
+    pareto(svg, "t", {{"a", 100, 0.1}});
+    ADD_FAILURE() << "a failing gnuplot went unnoticed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("simulated failure"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(svg.string()), std::string::npos) << e.what();
+  }
+  setenv("PATH", old_path.c_str(), 1);
+  EXPECT_TRUE(fs::is_empty(svg.parent_path()));
 }
 
 TEST_F(Plots, BadInputIsRefusedNamingTheSeries) {

@@ -58,14 +58,16 @@ struct CaseRun {
   std::vector<VariantResult> variants;
   std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
   double wall_time_s = 0.0;
+  std::string fem_cache_key;
+  bool fem_from_cache = false;
 };
 
 struct RunSettings {
   bool quiet = false;
   bool force_depth_curve = true;
   bool time_dynamics = true;
-  /// Where the FEM writes its VTU (the run's folder); none: not written.
-  std::optional<std::filesystem::path> fem_output_directory;
+  /// Where FEM results are cached (none: always solve).
+  std::optional<std::filesystem::path> fem_cache_directory;
 };
 
 /// Runs the case. Throws cases::InputError for bad input (naming the case file), std::runtime_error

@@ -1,0 +1,171 @@
+#include "msfem/compare/fem_cache.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "msfem/compare/atomic_file.hpp"
+
+namespace msfem::compare {
+namespace {
+
+// Bump when the FEM's formulation or the entry layout changes: old entries then miss.
+constexpr const char* cache_version = "msfem-fem-cache-3";
+
+class Fnv1a {
+ public:
+  void bytes(const void* data, std::size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i)
+      hash_ = (hash_ ^ p[i]) * 1099511628211ull;
+  }
+  void text(const std::string& s) { bytes(s.data(), s.size() + 1); }
+  void number(double x) { bytes(&x, sizeof x); }
+  template <typename Derived>
+  void matrix(const Eigen::DenseBase<Derived>& m) {
+    for (Eigen::Index i = 0; i < m.rows(); ++i)
+      for (Eigen::Index j = 0; j < m.cols(); ++j)
+        number(static_cast<double>(m(i, j)));
+  }
+  std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 14695981039346656037ull;
+};
+
+nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
+  return {{"rows", m.rows()},
+          {"cols", m.cols()},
+          {"data", std::vector<double>(m.data(), m.data() + m.size())}};
+}
+
+Eigen::MatrixXd matrix_from(const nlohmann::json& j) {
+  const auto data = j.at("data").get<std::vector<double>>();
+  const Eigen::Index rows = j.at("rows"), cols = j.at("cols");
+  if (static_cast<Eigen::Index>(data.size()) != rows * cols) throw std::runtime_error("bad matrix");
+  return Eigen::Map<const Eigen::MatrixXd>(data.data(), rows, cols);
+}
+
+nlohmann::json vec(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+Eigen::Vector3d vec_from(const nlohmann::json& j) {
+  return Eigen::Vector3d(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>());
+}
+
+}  // namespace
+
+std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths) {
+  const auto& p = problem.parameters;
+  Fnv1a h;
+  h.text(cache_version);
+  h.matrix(problem.surface.vertices);
+  h.matrix(problem.surface.triangles);
+  for (double x :
+       {p.material.youngs_modulus_pa, p.material.poisson_ratio, p.material.density_kg_per_m3})
+    h.number(x);
+  h.matrix(p.loads.gravity_m_per_s2);
+  h.number(static_cast<double>(p.support.kind));
+  h.number(p.support.inner_core_scale);
+  h.matrix(p.support.half_space_point);
+  h.matrix(p.support.half_space_normal);
+  h.matrix(p.support.sphere_center);
+  h.number(p.support.sphere_radius_m);
+  for (const auto& t : problem.tools) {
+    h.matrix(t.contact_point);
+    h.matrix(t.outward_normal);
+    h.number(t.radius);
+    h.number(t.depth);
+  }
+  const auto& patch = p.loads.patch_force;
+  h.number(patch.enabled);
+  h.matrix(patch.direction);
+  h.number(patch.radius_m);
+  h.matrix(patch.force_n);
+  h.number(p.fem.degree);
+  h.number(p.fem.cell_size_m);
+  h.text(p.fem.solver);
+  h.number(p.fem.relative_tolerance);
+  for (double d : curve_depths)
+    h.number(d);
+  char key[17];
+  std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(h.value()));
+  return key;
+}
+
+std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directory,
+                                            const std::string& key) {
+  std::ifstream in(directory / (key + ".cbor"), std::ios::binary);
+  if (!in) return std::nullopt;
+  try {
+    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                                          std::istreambuf_iterator<char>());
+    const nlohmann::json j = nlohmann::json::from_cbor(bytes);
+    if (j.at("version") != cache_version || j.at("key") != key) return std::nullopt;
+    FemCacheEntry e;
+    e.mesh.vertices = matrix_from(j.at("mesh_vertices"));
+    e.mesh.tetrahedra = matrix_from(j.at("mesh_tetrahedra")).cast<int>();
+    e.mesh.num_surface_vertices = j.at("num_surface_vertices");
+    auto& s = e.solution;
+    s.vertex_displacement = matrix_from(j.at("vertex_displacement"));
+    s.surface_displacement = s.vertex_displacement.topRows(e.mesh.num_surface_vertices);
+    s.tool_force = vec_from(j.at("tool_force"));
+    s.volume_change = j.at("volume_change");
+    const auto& st = j.at("statistics");
+    s.statistics.dofs = st.at("dofs");
+    s.statistics.cells = st.at("cells");
+    s.statistics.vertices = st.at("vertices");
+    s.statistics.prescribed_dofs = st.at("prescribed_dofs");
+    s.statistics.mpi_ranks = st.at("mpi_ranks");
+    s.statistics.iterations = st.at("iterations");
+    s.statistics.residual_norm = st.at("residual_norm");
+    s.statistics.setup_time_s = st.at("setup_time_s");
+    s.statistics.assemble_time_s = st.at("assemble_time_s");
+    s.statistics.solve_time_s = st.at("solve_time_s");
+    for (const auto& p : j.at("force_depth"))
+      e.force_depth.push_back({p.at("depth_m"), vec_from(p.at("force_N"))});
+    return e;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+void store_fem_cache(const std::filesystem::path& directory, const std::string& key,
+                     const FemCacheEntry& e) {
+  const auto& s = e.solution;
+  const auto& st = s.statistics;
+  nlohmann::json fd = nlohmann::json::array();
+  for (const auto& p : e.force_depth)
+    fd.push_back({{"depth_m", p.depth_m}, {"force_N", vec(p.force_n)}});
+  const nlohmann::json j = {{"version", cache_version},
+                            {"key", key},
+                            {"mesh_vertices", matrix_json(e.mesh.vertices)},
+                            {"mesh_tetrahedra", matrix_json(e.mesh.tetrahedra.cast<double>())},
+                            {"num_surface_vertices", e.mesh.num_surface_vertices},
+                            {"vertex_displacement", matrix_json(s.vertex_displacement)},
+                            {"tool_force", vec(s.tool_force)},
+                            {"volume_change", s.volume_change},
+                            {"statistics",
+                             {{"dofs", st.dofs},
+                              {"cells", st.cells},
+                              {"vertices", st.vertices},
+                              {"prescribed_dofs", st.prescribed_dofs},
+                              {"mpi_ranks", st.mpi_ranks},
+                              {"iterations", st.iterations},
+                              {"residual_norm", st.residual_norm},
+                              {"setup_time_s", st.setup_time_s},
+                              {"assemble_time_s", st.assemble_time_s},
+                              {"solve_time_s", st.solve_time_s}}},
+                            {"force_depth", fd}};
+  std::filesystem::create_directories(directory);
+  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(j);
+  write_file_atomically(directory / (key + ".cbor"), [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw std::runtime_error("write failed");
+  });
+}
+
+}  // namespace msfem::compare
