@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "msfem/cases/errors.hpp"
+
 namespace msfem::compare {
 
 namespace fs = std::filesystem;
@@ -50,6 +52,25 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
     out.close();  // close() flushes: a full disk shows up here, not after the rename
     if (!out) throw std::runtime_error("writing '" + temporary.string() + "' failed");
   });
+}
+
+void fill_directory_atomically(const fs::path& directory,
+                               const std::function<void(const fs::path& work)>& fill) {
+  if (fs::exists(directory) && !(fs::is_directory(directory) && fs::is_empty(directory)))
+    throw cases::InputError(directory.string() + ": output folder exists and is not empty");
+  const fs::path work = temporary_name_for(directory);
+  fs::create_directories(work);
+  try {
+    fill(work);
+    std::error_code ignored;
+    fs::remove(directory, ignored);  // an empty folder given with --out
+    if (directory.has_parent_path()) fs::create_directories(directory.parent_path());
+    fs::rename(work, directory);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(work, ignored);
+    throw;  // as it was: bad input stays bad input
+  }
 }
 
 }  // namespace msfem::compare

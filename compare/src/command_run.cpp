@@ -1,13 +1,13 @@
 // msfem run CASE.prm: both models on one problem, and a report a user can read, plot and open.
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
+#include <sstream>
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/compare/atomic_file.hpp"
 #include "msfem/compare/case_run.hpp"
 #include "msfem/compare/commands.hpp"
 #include "msfem/compare/options.hpp"
@@ -36,14 +36,8 @@ int run_command(const Arguments& args) {
                                               ? std::filesystem::path(*opt.value("out"))
                                               : std::filesystem::path(parameters.output.directory) /
                                                     (parameters.name + "-" + timestamp());
-  if (std::filesystem::exists(final_dir) && !std::filesystem::is_empty(final_dir))
-    throw cases::InputError(final_dir.string() + ": output folder exists and is not empty");
-  // Everything goes to a temporary sibling that is renamed when complete: a failed run leaves no
-  // run folder behind.
-  const std::filesystem::path work_dir =
-      final_dir.string() + ".tmp-" + std::to_string(static_cast<long>(getpid()));
-  std::filesystem::create_directories(work_dir);
-  try {
+  std::ostringstream printed;  // shown once the folder is in place
+  fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
     RunSettings settings;
     settings.quiet = opt.flag("quiet");
     settings.force_depth_curve = !opt.flag("no-curve");
@@ -53,23 +47,16 @@ int run_command(const Arguments& args) {
           std::filesystem::path(parameters.output.directory) / ".fem-cache";
     const CaseRun run = run_case(parameters, settings);
     write_run_outputs(run, work_dir);
-    if (std::filesystem::exists(final_dir)) std::filesystem::remove(final_dir);  // empty
-    std::filesystem::create_directories(final_dir.parent_path().empty() ? "."
-                                                                        : final_dir.parent_path());
-    std::filesystem::rename(work_dir, final_dir);
     if (opt.flag("json")) {
-      std::cout << summary_json(run).dump(2) << '\n';
+      printed << summary_json(run).dump(2) << '\n';
     } else {
-      std::cout << "case " << parameters.name << ": " << run.problem.surface.num_vertices()
-                << " surface vertices, FEM " << run.fem.statistics.dofs << " dofs ("
-                << run.fem.statistics.cells << " cells), run took " << run.wall_time_s << " s\n"
-                << variant_table(run) << "results in " << final_dir.string() << "\n";
+      printed << "case " << parameters.name << ": " << run.problem.surface.num_vertices()
+              << " surface vertices, FEM " << run.fem.statistics.dofs << " dofs ("
+              << run.fem.statistics.cells << " cells), run took " << run.wall_time_s << " s\n"
+              << variant_table(run) << "results in " << final_dir.string() << "\n";
     }
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove_all(work_dir, ignored);
-    throw;
-  }
+  });
+  std::cout << printed.str();
   return 0;
 }
 

@@ -24,6 +24,9 @@ const std::vector<CommandEntry>& commands() {
        "run CASE.prm [--out DIR] [--set SECTION/KEY=VALUE]... [--quiet] [--json] [--no-curve]\n"
        "      the FEM and every mass-spring variant on the case; summary.json, report.md, VTU, "
        "HDF5"},
+      {"sweep", sweep_command,
+       "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
+       "      variants x resolutions x integrators: sweep.json, table and Pareto plot"},
       {"params", params_command, "params\n      print the whole case-file language"},
       {"mesh-info", mesh_info_command,
        "mesh-info FILE [--unit m|cm|mm] [--json] [--no-self-intersections]\n"

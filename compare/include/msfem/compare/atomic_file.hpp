@@ -20,4 +20,10 @@ void write_file_atomically(
 /// write_file_atomically for a text: the whole of `text`, flushed and checked before the rename.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
 
+/// Creates `directory` with everything `fill` writes into the temporary folder it is given, renamed
+/// into place only when `fill` returns: a failed run leaves no folder behind. Throws
+/// cases::InputError if `directory` exists and is not empty; rethrows whatever `fill` throws.
+void fill_directory_atomically(const std::filesystem::path& directory,
+                               const std::function<void(const std::filesystem::path& work)>& fill);
+
 }  // namespace msfem::compare

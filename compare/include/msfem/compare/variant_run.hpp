@@ -56,7 +56,8 @@ struct Timing {
 };
 /// Times the case's integrator on the variant (with its loads), starting from rest, against the
 /// given static equilibrium (for the settle time).
+/// With measure_settling false the settle time is skipped (sweeps).
 Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
-                    const Eigen::VectorXd& equilibrium);
+                    const Eigen::VectorXd& equilibrium, bool measure_settling = true);
 
 }  // namespace msfem::compare

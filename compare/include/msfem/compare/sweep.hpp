@@ -1,0 +1,40 @@
+#pragma once
+// `msfem sweep`: accuracy against speed over variants × resolutions × integrators.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "msfem/cases/case_parameters.hpp"
+
+namespace msfem::compare {
+
+struct SweepSettings {
+  /// Icosphere levels (generator cases) or target vertex counts (file cases); empty: levels 2-5,
+  /// or 2k, 5k, 9.2k, 20k and 40k vertices capped at the surface's own count.
+  std::vector<int> resolutions;
+  std::vector<std::string> integrators = {"symplectic_euler", "central_difference", "rk4",
+                                          "implicit_euler"};
+  bool quiet = false;
+};
+
+struct SweepPoint {
+  std::string variant, integrator;
+  int resolution = 0;  ///< level or vertex target, as given
+  int surface_vertices = 0;
+  int nodes = 0, springs = 0;
+  double rel_l2_error = 0.0, reaction_force_rel_error = 0.0;
+  double stable_dt_s = 0.0, steps_per_second = 0.0, realtime_factor = 0.0;
+  double ms_per_60hz_frame = 0.0;
+};
+
+/// Runs the sweep (the FEM once per resolution, through the cache when given).
+std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
+                                  const SweepSettings& settings,
+                                  const std::filesystem::path& fem_cache_directory);
+
+nlohmann::json sweep_json(const cases::CaseParameters& parameters,
+                          const std::vector<SweepPoint>& points);
+std::string sweep_table(const std::vector<SweepPoint>& points);
+
+}  // namespace msfem::compare

@@ -1,0 +1,136 @@
+#include "msfem/compare/sweep.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include "msfem/cases/surface_io.hpp"
+#include "msfem/compare/case_run.hpp"
+#include "msfem/compare/run_outputs.hpp"
+
+namespace msfem::compare {
+namespace {
+
+bool is_generator(const std::string& source) {
+  return source.rfind("icosphere:", 0) == 0 || source.rfind("ellipsoid:", 0) == 0;
+}
+
+std::vector<int> default_resolutions(const cases::CaseParameters& p) {
+  if (is_generator(p.geometry.source)) return {2, 3, 4, 5};
+  const int available =
+      static_cast<int>(cases::read_surface(p.geometry.source, p.geometry.unit).num_vertices());
+  std::vector<int> r;
+  for (int n : {2000, 5000, 9177, 20000, 40000})
+    if (n < available) r.push_back(n);
+  r.push_back(available);
+  return r;
+}
+
+// The case at one resolution: the icosphere level replaced, or the simplification target set.
+cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
+  if (is_generator(p.geometry.source)) {
+    const auto first = p.geometry.source.find(':');
+    const auto second = p.geometry.source.find(':', first + 1);
+    p.geometry.source = p.geometry.source.substr(0, first + 1) + std::to_string(resolution) +
+                        (second == std::string::npos ? "" : p.geometry.source.substr(second));
+  } else {
+    p.geometry.simplify_to_vertices = resolution;
+  }
+  return p;
+}
+
+}  // namespace
+
+std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
+                                  const SweepSettings& settings,
+                                  const std::filesystem::path& fem_cache_directory) {
+  const std::vector<int> resolutions =
+      settings.resolutions.empty() ? default_resolutions(parameters) : settings.resolutions;
+  const Progress progress(settings.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<SweepPoint> points;
+  for (std::size_t r = 0; r < resolutions.size(); ++r) {
+    const cases::CaseParameters p = at_resolution(parameters, resolutions[r]);
+    RunSettings run_settings;
+    run_settings.quiet = true;
+    run_settings.force_depth_curve = false;
+    run_settings.time_dynamics = false;
+    run_settings.fem_cache_directory = fem_cache_directory;
+    const CaseRun run = run_case(p, run_settings);
+    const std::optional<ToolPlacement> tool =
+        run.problem.tools.empty() ? std::nullopt
+                                  : std::optional<ToolPlacement>(run.problem.tools.front());
+    for (const auto& v : run.variants) {
+      const BuiltVariant built = build_variant(v.name, run.problem, run.mesh, tool);
+      const Eigen::VectorXd equilibrium = solve_variant_static(built).x;
+      for (const auto& integrator : settings.integrators) {
+        cases::TimingParameters timing = p.timing;
+        timing.integrator = integrator;
+        timing.dt_s = 0.0;  // each integrator at half its own stable step
+        const Timing t = time_variant(built, timing, equilibrium, /*measure_settling=*/false);
+        SweepPoint pt;
+        pt.variant = v.name;
+        pt.integrator = integrator;
+        pt.resolution = resolutions[r];
+        pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
+        pt.nodes = v.nodes;
+        pt.springs = v.springs;
+        pt.rel_l2_error = v.errors.all.rel_l2_error;
+        pt.reaction_force_rel_error = v.reaction_force_rel_error;
+        pt.stable_dt_s = t.stable_dt_s;
+        pt.steps_per_second = t.steps_per_second;
+        pt.realtime_factor = t.realtime_factor;
+        pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
+        points.push_back(pt);
+      }
+    }
+    progress.advance(
+        "sweep resolution " + std::to_string(resolutions[r]), static_cast<int>(r + 1),
+        static_cast<int>(resolutions.size()),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return points;
+}
+
+nlohmann::json sweep_json(const cases::CaseParameters& parameters,
+                          const std::vector<SweepPoint>& points) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& p : points)
+    list.push_back({{"variant", p.variant},
+                    {"integrator", p.integrator},
+                    {"resolution", p.resolution},
+                    {"surface_vertices", p.surface_vertices},
+                    {"nodes", p.nodes},
+                    {"springs", p.springs},
+                    {"rel_l2_error", p.rel_l2_error},
+                    {"reaction_force_rel_error", p.reaction_force_rel_error},
+                    {"stable_dt_s", p.stable_dt_s},
+                    {"steps_per_second", p.steps_per_second},
+                    {"realtime_factor", p.realtime_factor},
+                    {"ms_per_60hz_frame", p.ms_per_60hz_frame}});
+  return {{"case", parameters.name},
+          {"git_revision", git_revision()},
+          {"machine", machine_description()},
+          {"units", {{"length", "m"}, {"time", "s"}}},
+          {"points", list}};
+}
+
+std::string sweep_table(const std::vector<SweepPoint>& points) {
+  std::ostringstream out;
+  out << "| variant | integrator | resolution | surface vertices | nodes | springs | rel L2 | "
+         "force err | stable dt s | steps/s | realtime factor | ms/60 Hz frame |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char row[512];
+  for (const auto& p : points) {
+    std::snprintf(row, sizeof row,
+                  "| %s | %s | %d | %d | %d | %d | %.4f | %.4f | %.3g | %.0f | %.3g | %.3f |\n",
+                  p.variant.c_str(), p.integrator.c_str(), p.resolution, p.surface_vertices,
+                  p.nodes, p.springs, p.rel_l2_error, p.reaction_force_rel_error, p.stable_dt_s,
+                  p.steps_per_second, p.realtime_factor, p.ms_per_60hz_frame);
+    out << row;
+  }
+  return out.str();
+}
+
+}  // namespace msfem::compare
