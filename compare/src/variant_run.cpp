@@ -169,7 +169,10 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
 StaticSolution solve_variant_static(const BuiltVariant& variant) {
   const ms::MassSpringModel& model = *variant.model;
   const auto start = Clock::now();
-  const ms::StaticResult r = ms::solve_static(model);
+  ms::StaticOptions options;
+  // A sparse factorisation's fill-in grows quickly with the brain-scale networks; CG does not.
+  if (model.num_nodes() > 5000) options.linear_solver = ms::StaticLinearSolver::cg;
+  const ms::StaticResult r = ms::solve_static(model, options);
   StaticSolution solution;
   solution.solve_time_s = seconds_since(start);
   if (!r.converged)

@@ -1,0 +1,126 @@
+// Steps per second of the mass-spring steppers on the seed sphere, the brain and 10 x the brain:
+// FastExplicitStepper (SoA, 2 threads, double and float), the naive scalar AoS loop, and
+// FastImplicitStepper at the haptic step of 1 ms. `--benchmark_filter=brain_scale` etc.
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <random>
+
+#include "msfem/massspring/benchmark_cases.hpp"
+#include "msfem/massspring/fast_implicit_stepper.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/stability.hpp"
+#include "obj_surface.hpp"
+
+namespace {
+
+using namespace msfem::massspring;
+
+// Models are built once per case and kept for all benchmarks of the run.
+const MassSpringModel& model_for(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<MassSpringModel>> models;
+  if (models.empty()) {
+    std::optional<Eigen::MatrixX3d> brain_vertices;
+    std::optional<Eigen::MatrixX3i> brain_triangles;
+    if (auto brain = bench::read_obj(MSFEM_BRAIN_OBJ, 1e-3)) {
+      brain_vertices = brain->vertices;
+      brain_triangles = brain->triangles;
+    }
+    for (auto& c : benchmark_cases(brain_vertices, brain_triangles)) {
+      auto model = std::make_unique<MassSpringModel>(c.network);
+      models.emplace(c.name, std::move(model));
+    }
+  }
+  return *models.at(name);
+}
+
+// Rest state with every node moved by a fixed pseudo-random 10⁻³ of the mean spring length, as in
+// run_stepping_benchmark: all springs loaded, the motion bounded.
+State perturbed_start(const MassSpringModel& model) {
+  State start = initial_state(model);
+  std::mt19937 generator(2007);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const double amplitude = 1e-3 * model.network().rest_length.mean();
+  for (Eigen::Index k = 0; k < start.x.size(); ++k)
+    start.x[k] += amplitude * uniform(generator);
+  model.enforce_constraints(start.x, start.v);
+  return start;
+}
+
+void annotate(benchmark::State& state, const MassSpringModel& model, int steps_per_iteration) {
+  state.SetItemsProcessed(state.iterations() * steps_per_iteration);  // items/s = steps/s
+  state.counters["nodes"] = model.num_nodes();
+  state.counters["springs"] = model.network().num_springs();
+}
+
+void explicit_step(benchmark::State& state, const std::string& name, bool single_precision,
+                   int threads) {
+  const MassSpringModel& model = model_for(name);
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  FastExplicitStepper stepper(model, FastStepperOptions{threads, single_precision, true});
+  stepper.set_state(perturbed_start(model));
+  constexpr int kSteps = 10;
+  for (auto _ : state)
+    stepper.step(dt, kSteps);
+  annotate(state, model, kSteps);
+}
+
+void naive_step(benchmark::State& state, const std::string& name) {
+  const MassSpringModel& model = model_for(name);
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  NaiveAosStepper stepper(model, perturbed_start(model));
+  for (auto _ : state)
+    stepper.step(dt);
+  annotate(state, model, 1);
+}
+
+void implicit_step(benchmark::State& state, const std::string& name) {
+  const MassSpringModel& model = model_for(name);
+  FastImplicitStepper stepper(model, FastImplicitOptions{2, true, 1e-3, 50});
+  stepper.set_state(perturbed_start(model));
+  long iterations = 0;
+  for (auto _ : state) {
+    stepper.step(1e-3);
+    iterations += stepper.last_cg_iterations();
+  }
+  annotate(state, model, 1);
+  state.counters["cg_iterations"] =
+      static_cast<double>(iterations) / static_cast<double>(std::max<long>(state.iterations(), 1));
+}
+
+void register_all() {
+  for (const std::string name : {"seed_sphere", "brain_scale", "brain_10x"}) {
+    benchmark::RegisterBenchmark(("explicit_soa_double_2threads/" + name).c_str(), explicit_step,
+                                 name, false, 2)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("explicit_soa_double_1thread/" + name).c_str(), explicit_step,
+                                 name, false, 1)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("explicit_soa_float_2threads/" + name).c_str(), explicit_step,
+                                 name, true, 2)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("naive_aos/" + name).c_str(), naive_step, name)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("implicit_soa_2threads/" + name).c_str(), implicit_step, name)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_all();
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,60 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+namespace msfem::massspring {
+
+/// Which linearisation of the force a Jacobian call returns.
+enum class Linearisation {
+  exact,    ///< the true derivative (what the finite-difference test checks)
+  definite  ///< ∂f/∂x made negative semi-definite (compressed springs' transverse term and the
+            ///< damper's geometric term dropped, Baraff & Witkin 1998 / Choi & Ko 2002), so that
+            ///< M - h ∂f/∂v - h² ∂f/∂x is SPD and conjugate gradients apply
+};
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+/// One force-model interface (Vega's ForceModel, SOFA's ForceField): everything an integrator or a
+/// static solver needs from a set of forces acting on n nodes. State vectors are node-major,
+/// x = (x0, y0, z0, x1, ...), of length num_dofs() = 3n. All "add_" calls accumulate into their
+/// output, which must already have the right size.
+class ForceModel {
+ public:
+  virtual ~ForceModel() = default;
+
+  virtual int num_dofs() const = 0;
+
+  /// f += f(x, v)
+  virtual void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                         Eigen::VectorXd& f) const = 0;
+
+  /// Potential energy of the conservative part, with f_conservative = -∇U.
+  virtual double potential_energy(const Eigen::VectorXd& x) const = 0;
+
+  /// df += (∂f/∂x)(x, v) · dx, matrix-free.
+  virtual void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                                Linearisation mode = Linearisation::exact) const = 0;
+
+  /// df += (∂f/∂v)(x) · dv, matrix-free.
+  virtual void add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
+                                Eigen::VectorXd& df) const = 0;
+
+  /// Triplets of ∂f/∂x (duplicates are summed by setFromTriplets).
+  virtual void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                 Triplets& triplets,
+                                 Linearisation mode = Linearisation::exact) const = 0;
+
+  /// Triplets of ∂f/∂v.
+  virtual void add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const = 0;
+
+  // Conveniences built on the virtual calls.
+  Eigen::VectorXd force(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
+  Eigen::SparseMatrix<double> dfdx(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                   Linearisation mode = Linearisation::exact) const;
+  Eigen::SparseMatrix<double> dfdv(const Eigen::VectorXd& x) const;
+};
+
+}  // namespace msfem::massspring

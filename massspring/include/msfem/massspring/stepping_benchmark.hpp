@@ -1,0 +1,66 @@
+#pragma once
+
+#include <vector>
+
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
+
+namespace msfem::massspring {
+
+/// The plain scalar array-of-structures loop every speed-up is measured against: one struct per
+/// node and per spring, forces zeroed, accumulated spring by spring, then symplectic Euler. Same
+/// physics as FastExplicitStepper (springs, dampers, node damping, loads, supports; no anchors).
+class NaiveAosStepper {
+ public:
+  explicit NaiveAosStepper(const MassSpringModel& model);
+  NaiveAosStepper(const MassSpringModel& model, const State& start);
+  void step(double dt);
+  State state() const;
+
+ private:
+  struct Node {
+    double x[3], v[3], f[3], load[3];
+    double mass, damping;
+    bool fixed;
+  };
+  struct Spring {
+    int a, b;
+    double stiffness, damping, rest_length;
+  };
+  std::vector<Node> nodes_;
+  std::vector<Spring> springs_;
+  double time_ = 0.0;
+};
+
+struct SteppingBenchmarkOptions {
+  int threads = 2;
+  bool single_precision = false;
+  int steps_per_call = 10;          ///< explicit steps per FastExplicitStepper::step call
+  double seconds_per_sample = 0.2;  ///< each sample runs at least this long
+  int samples = 5;                  ///< the median is reported
+  bool run_naive = true;
+  bool run_implicit = true;
+  double implicit_dt = 1e-3;  ///< haptic rate
+  double implicit_cg_tolerance = 1e-3;
+  int implicit_cg_max_iterations = 50;
+};
+
+struct SteppingBenchmarkResult {
+  int nodes = 0;
+  int springs = 0;
+  int threads = 0;
+  double explicit_dt = 0.0;                ///< 0.5 × predicted stable dt
+  double explicit_steps_per_second = 0.0;  ///< FastExplicitStepper, median
+  double naive_steps_per_second = 0.0;     ///< NaiveAosStepper, median (0 when not run)
+  double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
+  double implicit_mean_cg_iterations = 0.0;
+};
+
+/// Measures steps per second of the explicit fast stepper, the naive loop and the implicit fast
+/// stepper on the model (loads and supports as set in it), in this process, after a warm-up. All
+/// three start from the rest state with every free node displaced by a fixed pseudo-random 10⁻³ of
+/// the mean spring length, so that every spring is loaded and the run stays bounded.
+SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
+                                               const SteppingBenchmarkOptions& options = {});
+
+}  // namespace msfem::massspring

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "msfem/massspring/force_model.hpp"
+
+namespace msfem::massspring {
+
+class MassSpringModel;
+
+/// A rigid spherical tool tip.
+struct SphereTool {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+/// A sphere of radius r that touches the surface at `contact_point` from outside and is pushed by
+/// `depth` along `inward_direction` (the design's tool indentation).
+struct ToolIndentation {
+  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d inward_direction = -Eigen::Vector3d::UnitZ();  ///< normalised on use
+  double radius = 0.0;
+  double depth = 0.0;
+
+  /// The tool at full depth: centre = p + u (d - r).
+  SphereTool tool() const;
+};
+
+/// Frictionless contact between a sphere and a set of nodes, regularised by a penalty: a node at
+/// distance ρ < r from the centre is pushed out with f = k_p (r - ρ) (x - c)/ρ, U = ½ k_p (r - ρ)².
+/// Penetration at equilibrium is |f_node| / k_p, so k_p is chosen stiff against the springs.
+class SphereContactForceField : public ForceModel {
+ public:
+  SphereContactForceField(int num_nodes, std::vector<int> nodes, SphereTool tool,
+                          double penalty_stiffness);
+
+  int num_dofs() const override { return 3 * num_nodes_; }
+  void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                 Eigen::VectorXd& f) const override;
+  double potential_energy(const Eigen::VectorXd& x) const override;
+  void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                        const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                        Linearisation mode = Linearisation::exact) const override;
+  void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                        Eigen::VectorXd&) const override {}
+  void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
+                         Linearisation mode = Linearisation::exact) const override;
+  void add_dfdv_triplets(const Eigen::VectorXd&, Triplets&) const override {}
+
+  const SphereTool& tool() const { return tool_; }
+  const std::vector<int>& nodes() const { return nodes_; }
+  double penalty_stiffness() const { return penalty_; }
+
+ private:
+  Eigen::Matrix3d block(const Eigen::Vector3d& position, Linearisation mode) const;
+
+  int num_nodes_;
+  std::vector<int> nodes_;
+  SphereTool tool_;
+  double penalty_;
+};
+
+/// Prescribed-displacement version of the indentation: every surface node inside the tool at full
+/// depth is moved along the push direction onto the sphere (and held there). Returns the patch.
+std::vector<int> prescribe_contact_patch(MassSpringModel& model, const ToolIndentation& indent);
+
+/// Frictionless version: activates penalty contact of the tool at full depth with the model's
+/// surface nodes. penalty_stiffness <= 0 picks 1000 x the largest summed spring stiffness at a
+/// surface node. Returns the penalty stiffness used.
+double activate_sphere_contact(MassSpringModel& model, const ToolIndentation& indent,
+                               double penalty_stiffness = 0.0);
+
+/// Force the tissue exerts on the tool (what a haptic device renders), at state x (statics, v = 0):
+/// with a prescribed patch, the sum over the patch of the internal and applied forces, which at
+/// equilibrium balance the tool's push; with penalty contact, minus the sum of contact forces.
+Eigen::Vector3d patch_reaction_force(const MassSpringModel& model, const Eigen::VectorXd& x,
+                                     const std::vector<int>& patch);
+Eigen::Vector3d contact_reaction_force(const MassSpringModel& model, const Eigen::VectorXd& x);
+
+/// For dynamics: moves contact nodes inside the tool onto its surface (closest point) and removes
+/// their velocity component towards the centre. Returns the number of nodes projected.
+int project_out_of_tool(const MassSpringModel& model, Eigen::VectorXd& x, Eigen::VectorXd& v);
+
+}  // namespace msfem::massspring

@@ -1,0 +1,93 @@
+#include "msfem/massspring/integrators.hpp"
+
+#include <cmath>
+
+#include "msfem/massspring/errors.hpp"
+
+namespace msfem::massspring {
+
+State initial_state(const MassSpringModel& model) {
+  State state{model.rest_state(), Eigen::VectorXd::Zero(model.num_dofs()), 0.0};
+  model.enforce_constraints(state.x, state.v);
+  return state;
+}
+
+std::string to_string(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::explicit_euler:
+      return "explicit_euler";
+    case IntegratorKind::symplectic_euler:
+      return "symplectic_euler";
+    case IntegratorKind::central_difference:
+      return "central_difference";
+    case IntegratorKind::rk4:
+      return "rk4";
+    case IntegratorKind::implicit_euler:
+      return "implicit_euler";
+  }
+  return "unknown";
+}
+
+IntegratorKind parse_integrator(const std::string& name) {
+  for (IntegratorKind kind :
+       {IntegratorKind::explicit_euler, IntegratorKind::symplectic_euler,
+        IntegratorKind::central_difference, IntegratorKind::rk4, IntegratorKind::implicit_euler})
+    if (to_string(kind) == name) return kind;
+  throw ModelError("integrator '" + name +
+                   "': unknown (explicit_euler, symplectic_euler, "
+                   "central_difference, rk4, implicit_euler)");
+}
+
+void check_time_step(double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw ModelError("time step dt = " + std::to_string(dt) + " s must be finite and > 0");
+}
+
+void Integrator::step(const MassSpringModel& model, State& state, double dt) {
+  check_time_step(dt);
+  if (state.x.size() != model.num_dofs() || state.v.size() != model.num_dofs())
+    throw ModelError("state: size " + std::to_string(state.x.size()) + " does not match " +
+                     std::to_string(model.num_dofs()) + " model dofs");
+  last_cg_iterations_ = 0;
+  switch (kind_) {
+    case IntegratorKind::explicit_euler: {
+      const Eigen::VectorXd a = model.acceleration(state.x, state.v);
+      state.x += dt * state.v;
+      state.v += dt * a;
+      break;
+    }
+    case IntegratorKind::symplectic_euler: {
+      state.v += dt * model.acceleration(state.x, state.v);
+      state.x += dt * state.v;
+      break;
+    }
+    case IntegratorKind::central_difference: {
+      state.v += 0.5 * dt * model.acceleration(state.x, state.v);
+      state.x += dt * state.v;
+      state.v += 0.5 * dt * model.acceleration(state.x, state.v);
+      break;
+    }
+    case IntegratorKind::rk4: {
+      const Eigen::VectorXd& x = state.x;
+      const Eigen::VectorXd& v = state.v;
+      const Eigen::VectorXd a1 = model.acceleration(x, v);
+      const Eigen::VectorXd v2 = v + 0.5 * dt * a1;
+      const Eigen::VectorXd a2 = model.acceleration(x + 0.5 * dt * v, v2);
+      const Eigen::VectorXd v3 = v + 0.5 * dt * a2;
+      const Eigen::VectorXd a3 = model.acceleration(x + 0.5 * dt * v2, v3);
+      const Eigen::VectorXd v4 = v + dt * a3;
+      const Eigen::VectorXd a4 = model.acceleration(x + dt * v3, v4);
+      state.x += dt / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4);
+      state.v += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+      break;
+    }
+    case IntegratorKind::implicit_euler:
+      implicit_euler_step(model, state, dt);
+      break;
+  }
+  model.enforce_constraints(state.x, state.v);
+  project_out_of_tool(model, state.x, state.v);
+  state.time += dt;
+}
+
+}  // namespace msfem::massspring

@@ -1,0 +1,254 @@
+#include "msfem/massspring/mass_spring_model.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "msfem/massspring/errors.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+std::string num(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+void check_non_negative(double value, const std::string& item) {
+  if (!(value >= 0.0) || !std::isfinite(value))
+    throw ModelError(item + ": " + num(value) + " must be finite and >= 0");
+}
+
+}  // namespace
+
+MassSpringModel::MassSpringModel(SpringNetwork network) : network_(std::move(network)) {
+  network_.validate();
+  const int n = network_.num_nodes();
+  external_force_ = Eigen::MatrixX3d::Zero(n, 3);
+  prescribed_displacement_ = Eigen::MatrixX3d::Zero(n, 3);
+  constrained_.assign(n, 0);
+  for (int node : network_.fixed_nodes)
+    fix_node(node);
+}
+
+int MassSpringModel::check_node(int node, const char* what) const {
+  if (node < 0 || node >= num_nodes())
+    throw ModelError(std::string(what) + " " + std::to_string(node) + ": out of range [0, " +
+                     std::to_string(num_nodes()) + ")");
+  return node;
+}
+
+std::vector<int> MassSpringModel::springs_in_group(const std::string& group) const {
+  const int id = network_.spring_group_id(group);
+  std::vector<int> members;
+  for (int s = 0; s < network_.num_springs(); ++s)
+    if (network_.spring_group[s] == id) members.push_back(s);
+  return members;
+}
+
+void MassSpringModel::set_group_stiffness(const std::string& group, double stiffness) {
+  check_non_negative(stiffness, "spring group '" + group + "' stiffness");
+  for (int s : springs_in_group(group))
+    network_.stiffness[s] = stiffness;
+}
+
+void MassSpringModel::scale_group_stiffness(const std::string& group, double factor) {
+  check_non_negative(factor, "spring group '" + group + "' stiffness factor");
+  for (int s : springs_in_group(group))
+    network_.stiffness[s] *= factor;
+}
+
+void MassSpringModel::set_group_damping(const std::string& group, double damping) {
+  check_non_negative(damping, "spring group '" + group + "' damping");
+  for (int s : springs_in_group(group))
+    network_.damping[s] = damping;
+}
+
+void MassSpringModel::set_stiffness(const Eigen::VectorXd& stiffness) {
+  if (stiffness.size() != network_.num_springs())
+    throw ModelError("stiffness: " + std::to_string(stiffness.size()) + " values for " +
+                     std::to_string(network_.num_springs()) + " springs");
+  for (Eigen::Index s = 0; s < stiffness.size(); ++s)
+    check_non_negative(stiffness[s], "spring " + std::to_string(s) + " stiffness");
+  network_.stiffness = stiffness;
+}
+
+void MassSpringModel::set_damping(const Eigen::VectorXd& damping) {
+  if (damping.size() != network_.num_springs())
+    throw ModelError("damping: " + std::to_string(damping.size()) + " values for " +
+                     std::to_string(network_.num_springs()) + " springs");
+  for (Eigen::Index s = 0; s < damping.size(); ++s)
+    check_non_negative(damping[s], "spring " + std::to_string(s) + " damping");
+  network_.damping = damping;
+}
+
+void MassSpringModel::set_node_group_mass(const std::string& group, double mass_per_node) {
+  const int id = network_.node_group_id(group);
+  if (!(mass_per_node > 0.0) || !std::isfinite(mass_per_node))
+    throw ModelError("node group '" + group + "' mass " + num(mass_per_node) +
+                     " must be finite and > 0");
+  for (int i = 0; i < num_nodes(); ++i)
+    if (network_.node_group[i] == id) network_.masses[i] = mass_per_node;
+}
+
+void MassSpringModel::set_masses(const Eigen::VectorXd& masses) {
+  if (masses.size() != num_nodes())
+    throw ModelError("masses: " + std::to_string(masses.size()) + " values for " +
+                     std::to_string(num_nodes()) + " nodes");
+  for (Eigen::Index i = 0; i < masses.size(); ++i)
+    if (!(masses[i] > 0.0) || !std::isfinite(masses[i]))
+      throw ModelError("node " + std::to_string(i) + ": mass " + num(masses[i]) +
+                       " must be finite and > 0");
+  network_.masses = masses;
+}
+
+void MassSpringModel::set_node_damping(double damping_per_node) {
+  check_non_negative(damping_per_node, "node damping");
+  network_.node_damping.setConstant(damping_per_node);
+}
+
+void MassSpringModel::set_anchor_parameters(double stiffness, double damping) {
+  check_non_negative(stiffness, "anchor stiffness");
+  check_non_negative(damping, "anchor damping");
+  network_.anchor_stiffness.setConstant(stiffness);
+  network_.anchor_damping.setConstant(damping);
+}
+
+void MassSpringModel::set_external_force(int node, const Eigen::Vector3d& force) {
+  check_node(node, "external force on node");
+  if (!force.allFinite())
+    throw ModelError("external force on node " + std::to_string(node) + ": not finite");
+  external_force_.row(node) = force.transpose();
+}
+
+void MassSpringModel::clear_external_forces() {
+  external_force_.setZero();
+}
+
+void MassSpringModel::prescribe_displacement(int node, const Eigen::Vector3d& displacement) {
+  check_node(node, "prescribed node");
+  if (!displacement.allFinite())
+    throw ModelError("prescribed node " + std::to_string(node) + ": displacement not finite");
+  constrained_[node] = 1;
+  prescribed_displacement_.row(node) = displacement.transpose();
+}
+
+void MassSpringModel::release_node(int node) {
+  check_node(node, "released node");
+  constrained_[node] = 0;
+  prescribed_displacement_.row(node).setZero();
+}
+
+std::vector<int> MassSpringModel::constrained_nodes() const {
+  std::vector<int> nodes;
+  for (int i = 0; i < num_nodes(); ++i)
+    if (constrained_[i]) nodes.push_back(i);
+  return nodes;
+}
+
+Eigen::Vector3d MassSpringModel::constrained_target(int node) const {
+  check_node(node, "node");
+  return (network_.rest_positions.row(node) + prescribed_displacement_.row(node)).transpose();
+}
+
+void MassSpringModel::set_contact(const SphereContactForceField& contact) {
+  if (contact.num_dofs() != num_dofs())
+    throw ModelError("contact: built for " + std::to_string(contact.num_dofs() / 3) +
+                     " nodes, model has " + std::to_string(num_nodes()));
+  contact_ = contact;
+}
+
+void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                Eigen::VectorXd& f) const {
+  springs().add_force(x, v, f);
+  for (int i = 0; i < num_nodes(); ++i)
+    f.segment<3>(3 * i) += network_.masses[i] * gravity_ + external_force_.row(i).transpose();
+  if (contact_) contact_->add_force(x, v, f);
+}
+
+double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
+  double energy = springs().potential_energy(x);
+  // Constant loads: U = -Σ (m_i g + f_i)·x_i.
+  for (int i = 0; i < num_nodes(); ++i)
+    energy -= (network_.masses[i] * gravity_ + external_force_.row(i).transpose())
+                  .dot(x.segment<3>(3 * i));
+  if (contact_) energy += contact_->potential_energy(x);
+  return energy;
+}
+
+void MassSpringModel::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                       const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                                       Linearisation mode) const {
+  springs().add_dfdx_product(x, v, dx, df, mode);
+  if (contact_) contact_->add_dfdx_product(x, v, dx, df, mode);
+}
+
+void MassSpringModel::add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
+                                       Eigen::VectorXd& df) const {
+  springs().add_dfdv_product(x, dv, df);
+}
+
+void MassSpringModel::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                        Triplets& triplets, Linearisation mode) const {
+  springs().add_dfdx_triplets(x, v, triplets, mode);
+  if (contact_) contact_->add_dfdx_triplets(x, v, triplets, mode);
+}
+
+void MassSpringModel::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const {
+  springs().add_dfdv_triplets(x, triplets);
+}
+
+Eigen::VectorXd MassSpringModel::initial_state() const {
+  Eigen::VectorXd x = rest_state();
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  enforce_constraints(x, v);
+  return x;
+}
+
+Eigen::VectorXd MassSpringModel::mass_per_dof() const {
+  Eigen::VectorXd m(num_dofs());
+  for (int i = 0; i < num_nodes(); ++i)
+    m.segment<3>(3 * i).setConstant(network_.masses[i]);
+  return m;
+}
+
+void MassSpringModel::enforce_constraints(Eigen::VectorXd& x, Eigen::VectorXd& v) const {
+  for (int i = 0; i < num_nodes(); ++i) {
+    if (!constrained_[i]) continue;
+    x.segment<3>(3 * i) =
+        (network_.rest_positions.row(i) + prescribed_displacement_.row(i)).transpose();
+    v.segment<3>(3 * i).setZero();
+  }
+}
+
+void MassSpringModel::zero_constrained(Eigen::VectorXd& vector) const {
+  for (int i = 0; i < num_nodes(); ++i)
+    if (constrained_[i]) vector.segment<3>(3 * i).setZero();
+}
+
+Eigen::VectorXd MassSpringModel::acceleration(const Eigen::VectorXd& x,
+                                              const Eigen::VectorXd& v) const {
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(num_dofs());
+  add_force(x, v, a);
+  for (int i = 0; i < num_nodes(); ++i)
+    a.segment<3>(3 * i) *= constrained_[i] ? 0.0 : 1.0 / network_.masses[i];
+  return a;
+}
+
+double MassSpringModel::kinetic_energy(const Eigen::VectorXd& v) const {
+  double energy = 0.0;
+  for (int i = 0; i < num_nodes(); ++i)
+    energy += 0.5 * network_.masses[i] * v.segment<3>(3 * i).squaredNorm();
+  return energy;
+}
+
+Eigen::MatrixX3d MassSpringModel::surface_displacement(const Eigen::VectorXd& x) const {
+  Eigen::MatrixX3d u(network_.surface_nodes.size(), 3);
+  for (std::size_t k = 0; k < network_.surface_nodes.size(); ++k) {
+    const int i = network_.surface_nodes[k];
+    u.row(k) = x.segment<3>(3 * i).transpose() - network_.rest_positions.row(i);
+  }
+  return u;
+}
+
+}  // namespace msfem::massspring

@@ -1,0 +1,198 @@
+#pragma once
+
+// Structure-of-arrays copy of a MassSpringModel shared by the fast steppers (internal): nodes
+// renumbered (reverse Cuthill-McKee, constrained nodes last), springs sorted by their first node,
+// CSR incidence of springs on free nodes with the sign of the spring force on that node, and the
+// per-node constant terms (loads, anchors, damping).
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
+#include "node_ordering.hpp"
+
+namespace msfem::massspring::detail {
+
+template <class Real>
+struct SoaLayout {
+  int num_nodes = 0, num_springs = 0, num_free = 0;
+  bool has_spring_damping = false;
+  std::vector<int> order, new_id, spring_old_id;  // order[new] = old
+  std::vector<int> a, b, offset, incident;
+  std::vector<Real> stiffness, stiffness_rest, rest_length, damping, sign;
+  std::vector<Real> inverse_mass, mass, node_damping, anchor_stiffness;
+  std::vector<Real> x[3], v[3], load[3];
+  std::vector<int> spring_begin, node_begin;  // per thread-team member
+
+  SoaLayout(const MassSpringModel& model, bool reorder, int members) {
+    const SpringNetwork& net = model.network();
+    num_nodes = net.num_nodes();
+    num_springs = net.num_springs();
+    build_order(model, reorder);
+    build_springs(net);
+    build_incidence();
+    for (int c = 0; c < 3; ++c) {
+      x[c].assign(num_nodes, Real(0));
+      v[c].assign(num_nodes, Real(0));
+      load[c].assign(num_nodes, Real(0));
+    }
+    inverse_mass.assign(num_nodes, Real(0));
+    mass.assign(num_nodes, Real(0));
+    node_damping.assign(num_nodes, Real(0));
+    anchor_stiffness.assign(num_nodes, Real(0));
+    load_parameters(model);
+    set_state(model, initial_state(model));
+    partition(members);
+  }
+
+  void load_parameters(const MassSpringModel& model) {
+    const SpringNetwork& net = model.network();
+    if (net.num_nodes() != num_nodes || net.num_springs() != num_springs)
+      throw ModelError(
+          "fast stepper: model topology changed (nodes or springs); build a new stepper");
+    for (int i = 0; i < num_nodes; ++i)
+      if (model.is_constrained(order[i]) != (i >= num_free))
+        throw ModelError("fast stepper: supports changed at node " + std::to_string(order[i]) +
+                         "; build a new stepper");
+    has_spring_damping = false;
+    for (int s = 0; s < num_springs; ++s) {
+      const int old = spring_old_id[s];
+      stiffness[s] = static_cast<Real>(net.stiffness[old]);
+      stiffness_rest[s] = static_cast<Real>(net.stiffness[old] * net.rest_length[old]);
+      rest_length[s] = static_cast<Real>(net.rest_length[old]);
+      damping[s] = static_cast<Real>(net.damping[old]);
+      has_spring_damping = has_spring_damping || net.damping[old] != 0.0;
+    }
+    // Anchors (-k_a (x - p) - c_a v) fold into per-node terms: k_a p joins the loads.
+    Eigen::VectorXd anchor_k = Eigen::VectorXd::Zero(num_nodes);
+    Eigen::VectorXd anchor_c = Eigen::VectorXd::Zero(num_nodes);
+    Eigen::MatrixX3d anchor_kp = Eigen::MatrixX3d::Zero(num_nodes, 3);
+    for (int k = 0; k < net.num_anchors(); ++k) {
+      const int i = net.anchor_node[k];
+      anchor_k[i] += net.anchor_stiffness[k];
+      anchor_c[i] += net.anchor_damping[k];
+      anchor_kp.row(i) += net.anchor_stiffness[k] * net.anchor_point.row(k);
+    }
+    for (int i = 0; i < num_nodes; ++i) {
+      const int old = order[i];
+      if (i >= num_free) {  // supports follow a moved target (e.g. a tool patch)
+        const Eigen::Vector3d target = model.constrained_target(old);
+        for (int c = 0; c < 3; ++c) {
+          x[c][i] = static_cast<Real>(target[c]);
+          v[c][i] = Real(0);
+        }
+      }
+      mass[i] = static_cast<Real>(net.masses[old]);
+      inverse_mass[i] = static_cast<Real>(1.0 / net.masses[old]);
+      node_damping[i] = static_cast<Real>(net.node_damping[old] + anchor_c[old]);
+      anchor_stiffness[i] = static_cast<Real>(anchor_k[old]);
+      for (int c = 0; c < 3; ++c)
+        load[c][i] = static_cast<Real>(net.masses[old] * model.gravity()[c] +
+                                       model.external_forces()(old, c) + anchor_kp(old, c));
+    }
+  }
+
+  void set_state(const MassSpringModel& model, const State& state) {
+    if (state.x.size() != 3 * num_nodes || state.v.size() != 3 * num_nodes)
+      throw ModelError("fast stepper: state size " + std::to_string(state.x.size()) +
+                       " does not match " + std::to_string(3 * num_nodes) + " dofs");
+    State held = state;
+    model.enforce_constraints(held.x, held.v);
+    for (int i = 0; i < num_nodes; ++i)
+      for (int c = 0; c < 3; ++c) {
+        x[c][i] = static_cast<Real>(held.x[3 * order[i] + c]);
+        v[c][i] = static_cast<Real>(held.v[3 * order[i] + c]);
+      }
+  }
+
+  State state(double time) const {
+    State out{Eigen::VectorXd(3 * num_nodes), Eigen::VectorXd(3 * num_nodes), time};
+    for (int i = 0; i < num_nodes; ++i)
+      for (int c = 0; c < 3; ++c) {
+        out.x[3 * order[i] + c] = x[c][i];
+        out.v[3 * order[i] + c] = v[c][i];
+      }
+    return out;
+  }
+
+ private:
+  void build_order(const MassSpringModel& model, bool reorder) {
+    order.resize(num_nodes);
+    std::iota(order.begin(), order.end(), 0);
+    if (reorder) order = reverse_cuthill_mckee(num_nodes, model.network().springs);
+    std::stable_partition(order.begin(), order.end(),
+                          [&](int old) { return !model.is_constrained(old); });
+    new_id.assign(num_nodes, 0);
+    for (int i = 0; i < num_nodes; ++i)
+      new_id[order[i]] = i;
+    num_free = 0;
+    for (int old : order)
+      num_free += model.is_constrained(old) ? 0 : 1;
+  }
+
+  void build_springs(const SpringNetwork& net) {
+    spring_old_id.resize(num_springs);
+    std::iota(spring_old_id.begin(), spring_old_id.end(), 0);
+    auto first = [&](int s) {
+      return std::min(new_id[net.springs(s, 0)], new_id[net.springs(s, 1)]);
+    };
+    std::stable_sort(spring_old_id.begin(), spring_old_id.end(),
+                     [&](int p, int q) { return first(p) < first(q); });
+    a.resize(num_springs);
+    b.resize(num_springs);
+    stiffness.resize(num_springs);
+    stiffness_rest.resize(num_springs);
+    rest_length.resize(num_springs);
+    damping.resize(num_springs);
+    for (int s = 0; s < num_springs; ++s) {
+      a[s] = new_id[net.springs(spring_old_id[s], 0)];
+      b[s] = new_id[net.springs(spring_old_id[s], 1)];
+    }
+  }
+
+  void build_incidence() {
+    offset.assign(num_free + 1, 0);
+    for (int s = 0; s < num_springs; ++s) {
+      if (a[s] < num_free) ++offset[a[s] + 1];
+      if (b[s] < num_free) ++offset[b[s] + 1];
+    }
+    std::partial_sum(offset.begin(), offset.end(), offset.begin());
+    incident.resize(offset.back());
+    sign.resize(offset.back());
+    std::vector<int> fill(offset.begin(), offset.end() - 1);
+    for (int s = 0; s < num_springs; ++s) {
+      if (a[s] < num_free) {
+        incident[fill[a[s]]] = s;
+        sign[fill[a[s]]++] = Real(1);
+      }
+      if (b[s] < num_free) {
+        incident[fill[b[s]]] = s;
+        sign[fill[b[s]]++] = Real(-1);
+      }
+    }
+  }
+
+  // Equal shares of springs; node shares balanced by incidence count (the gather's work).
+  void partition(int members) {
+    spring_begin.resize(members + 1);
+    node_begin.resize(members + 1);
+    for (int m = 0; m <= members; ++m)
+      spring_begin[m] = static_cast<int>(static_cast<long>(num_springs) * m / members);
+    node_begin[0] = 0;
+    int node = 0;
+    const long total = static_cast<long>(offset.back()) + num_free;
+    for (int m = 1; m < members; ++m) {
+      const long target = total * m / members;
+      while (node < num_free && offset[node] + node < target)
+        ++node;
+      node_begin[m] = node;
+    }
+    node_begin[members] = num_free;
+  }
+};
+
+}  // namespace msfem::massspring::detail

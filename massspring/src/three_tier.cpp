@@ -1,0 +1,139 @@
+// Three-tier layered model (the brain seed): the surface, two inward copies, springs between them.
+
+#include <cmath>
+#include <string>
+
+#include "builder_support.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/surface_geometry.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+void check_options(const ThreeTierOptions& options) {
+  if (options.inner_tiers == InnerTierMethod::scaling) {
+    if (!std::isfinite(options.tier2_scale) || !(options.tier2_scale > 1.0))
+      throw ModelError("three_tier tier2_scale " + std::to_string(options.tier2_scale) +
+                       " must be finite and > 1");
+    if (!std::isfinite(options.tier3_scale) || !(options.tier3_scale > options.tier2_scale))
+      throw ModelError("three_tier tier3_scale " + std::to_string(options.tier3_scale) +
+                       " must be finite and > tier2_scale");
+  } else {
+    if (!std::isfinite(options.tier2_offset) || !std::isfinite(options.tier3_offset))
+      throw ModelError("three_tier tier offsets must be finite");
+    if (options.tier2_offset > 0.0 && options.tier3_offset > 0.0 &&
+        !(options.tier3_offset > options.tier2_offset))
+      throw ModelError("three_tier tier3_offset " + std::to_string(options.tier3_offset) +
+                       " must exceed tier2_offset " + std::to_string(options.tier2_offset));
+  }
+}
+
+// Inner tier k by scaling about the centroid or by offset along the inward normal.
+Eigen::MatrixX3d inner_tier(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3d& normals,
+                            const Eigen::Vector3d& centroid, double mean_radius,
+                            const ThreeTierOptions& options, double scale, double offset) {
+  if (options.inner_tiers == InnerTierMethod::scaling)
+    return ((vertices.rowwise() - centroid.transpose()) / scale).rowwise() + centroid.transpose();
+  const double depth = offset > 0.0 ? offset : (1.0 - 1.0 / scale) * mean_radius;
+  return vertices - depth * normals;
+}
+
+// Reports inner-tier nodes found outside the next outer tier.
+void check_nesting(SpringNetwork& network, const Eigen::MatrixX3d& inner,
+                   const Eigen::MatrixX3d& outer, const Eigen::MatrixX3i& triangles,
+                   const char* inner_name, const char* outer_name, bool reject) {
+  const std::vector<int> outside = points_outside_surface(inner, outer, triangles);
+  if (outside.empty()) return;
+  const std::string message =
+      std::string("three_tier: ") + std::to_string(outside.size()) + " of " +
+      std::to_string(inner.rows()) + " " + inner_name + " nodes (first: vertex " +
+      std::to_string(outside.front()) + ") lie outside " + outer_name +
+      "; scaling a concave surface does that, use InnerTierMethod::normal_offset";
+  if (reject) throw ModelError(message);
+  network.warnings.push_back(message);
+}
+
+}  // namespace
+
+SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
+                               const ThreeTierOptions& options) {
+  check_surface(vertices, triangles, "three_tier surface");
+  detail::check_material(options.material);
+  check_options(options);
+
+  const int nv = static_cast<int>(vertices.rows());
+  const Eigen::Vector3d centroid = vertex_centroid(vertices);
+  const Eigen::MatrixX3d normals = vertex_normals(vertices, triangles);
+  const double mean_radius = (vertices.rowwise() - centroid.transpose()).rowwise().norm().mean();
+  const Eigen::MatrixX3d tier2 = inner_tier(vertices, normals, centroid, mean_radius, options,
+                                            options.tier2_scale, options.tier2_offset);
+  const Eigen::MatrixX3d tier3 = inner_tier(vertices, normals, centroid, mean_radius, options,
+                                            options.tier3_scale, options.tier3_offset);
+
+  SpringNetwork network;
+  check_nesting(network, tier2, vertices, triangles, "tier 2", "tier 1",
+                options.reject_inner_tier_outside);
+  check_nesting(network, tier3, tier2, triangles, "tier 3", "tier 2",
+                options.reject_inner_tier_outside);
+
+  detail::add_nodes(network, vertices, "tier1");
+  detail::add_nodes(network, tier2, "tier2");
+  detail::add_nodes(network, tier3, "tier3");
+
+  // Springs: 4E + 2V.
+  const auto edges = unique_edges(triangles);
+  std::vector<std::array<int, 2>> tier1_edges, tier2_edges, diagonals, radial12, radial23;
+  for (const auto& [a, b] : edges) {
+    tier1_edges.push_back({a, b});
+    tier2_edges.push_back({nv + a, nv + b});
+    diagonals.push_back({a, nv + b});  // two crossing diagonals of the quad a1 b1 b2 a2
+    diagonals.push_back({b, nv + a});
+  }
+  for (int i = 0; i < nv; ++i) {
+    radial12.push_back({i, nv + i});
+    radial23.push_back({nv + i, 2 * nv + i});
+  }
+  const int g1 = add_springs(network, tier1_edges, "tier1_edges");
+  const int g2 = add_springs(network, tier2_edges, "tier2_edges");
+  const int g12 = add_springs(network, diagonals, "tier12_diagonals");
+  const int r12 = add_springs(network, radial12, "tier12_radial");
+  const int r23 = add_springs(network, radial23, "tier23_radial");
+
+  // Masses lumped from volume: half of each shell to each of its two tiers, by vertex area; the
+  // core inside tier 3 to tier 3. Volumes of inverted (non-nested) tiers are clamped at zero.
+  const double volume1 = std::abs(enclosed_volume(vertices, triangles));
+  const double volume2 = std::abs(enclosed_volume(tier2, triangles));
+  const double volume3 = std::abs(enclosed_volume(tier3, triangles));
+  const double shell12 = std::max(volume1 - volume2, 0.0);
+  const double shell23 = std::max(volume2 - volume3, 0.0);
+  const double rho = options.material.density;
+  const double total_mass = rho * volume1;
+  const double tier_mass[3] = {rho * 0.5 * shell12, rho * 0.5 * (shell12 + shell23),
+                               rho * (0.5 * shell23 + volume3)};
+  const Eigen::MatrixX3d* tiers[3] = {&vertices, &tier2, &tier3};
+  const double floor_mass =
+      1e-6 * total_mass / (3.0 * nv);  // keeps masses > 0 if a shell collapses
+  for (int t = 0; t < 3; ++t) {
+    const Eigen::VectorXd areas = vertex_areas(*tiers[t], triangles);
+    const double area_sum = areas.sum();
+    for (int i = 0; i < nv; ++i)
+      network.masses[t * nv + i] =
+          std::max(tier_mass[t] * (area_sum > 0.0 ? areas[i] / area_sum : 1.0 / nv), floor_mass);
+  }
+
+  const double modulus = options.material.youngs_modulus;
+  detail::assign_network_stiffness(network, {g1, g2, g12, r12}, modulus, shell12);
+  detail::assign_network_stiffness(network, {r23}, modulus, shell23);
+  detail::assign_damping(network, options.material);
+
+  for (int i = 0; i < nv; ++i) {
+    network.surface_nodes.push_back(i);
+    network.fixed_nodes.push_back(2 * nv + i);
+  }
+  network.surface_triangles = triangles;
+  network.validate();
+  return network;
+}
+
+}  // namespace msfem::massspring

@@ -1,0 +1,137 @@
+// The fast structure-of-arrays steppers and the naive loop reproduce the reference integrators.
+
+#include <gtest/gtest.h>
+
+#include "icosphere.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_implicit_stepper.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/stability.hpp"
+#include "msfem/massspring/stepping_benchmark.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+MassSpringModel loaded_three_tier() {
+  const auto mesh = testing::icosphere(2, 0.05);
+  ThreeTierOptions options;
+  options.material.spring_damping = 0.01;
+  options.material.node_damping = 0.002;
+  MassSpringModel model(build_three_tier(mesh.vertices, mesh.triangles, options));
+  model.set_gravity({0.0, -9.81, 0.0});
+  model.set_external_force(5, {0.0, 0.0, 0.01});
+  return model;
+}
+
+double relative_difference(const State& a, const State& b, const Eigen::VectorXd& rest) {
+  return (a.x - b.x).norm() / (b.x - rest).norm();
+}
+
+State reference_run(const MassSpringModel& model, IntegratorKind kind, double dt, int steps) {
+  Integrator integrator(kind, ImplicitOptions{1e-12, 1000});
+  State state = initial_state(model);
+  for (int n = 0; n < steps; ++n)
+    integrator.step(model, state, dt);
+  return state;
+}
+
+TEST(FastExplicitStepper, MatchesSymplecticEulerInDoubleAndFloat) {
+  const MassSpringModel model = loaded_three_tier();
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  const State reference = reference_run(model, IntegratorKind::symplectic_euler, dt, 300);
+  for (int threads : {1, 2}) {
+    FastExplicitStepper fast(model, FastStepperOptions{threads, false, true});
+    fast.step(dt, 100);
+    fast.step(dt, 200);
+    EXPECT_LE(relative_difference(fast.state(), reference, model.rest_state()), 1e-9) << threads;
+    EXPECT_NEAR(fast.state().time, reference.time, 1e-12);
+  }
+  FastExplicitStepper single(model, FastStepperOptions{2, true, true});
+  single.step(dt, 300);
+  EXPECT_LE(relative_difference(single.state(), reference, model.rest_state()), 1e-3);
+
+  NaiveAosStepper naive(model);
+  MassSpringModel unloaded = model;  // the naive loop has no external nodal forces
+  unloaded.clear_external_forces();
+  NaiveAosStepper naive_unloaded(unloaded);
+  for (int n = 0; n < 300; ++n)
+    naive_unloaded.step(dt);
+  const State unloaded_reference =
+      reference_run(unloaded, IntegratorKind::symplectic_euler, dt, 300);
+  EXPECT_LE(relative_difference(naive_unloaded.state(), unloaded_reference, model.rest_state()),
+            1e-9);
+}
+
+TEST(FastExplicitStepper, AnchorsAndRunTimeStiffnessChanges) {
+  const auto mesh = testing::icosphere(2, 0.05);
+  MassSpringModel model(build_single_layer(mesh.vertices, mesh.triangles));
+  model.set_gravity({0.0, 0.0, -9.81});
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  FastExplicitStepper fast(model);
+  fast.step(dt, 100);
+  Integrator integrator(IntegratorKind::symplectic_euler);
+  State reference = initial_state(model);
+  for (int n = 0; n < 100; ++n)
+    integrator.step(model, reference, dt);
+  EXPECT_LE(relative_difference(fast.state(), reference, model.rest_state()), 1e-9);
+
+  // Change a group's stiffness between steps: both follow without rebuilding.
+  model.scale_group_stiffness("surface_edges", 0.5);
+  fast.update_parameters(model);
+  fast.step(dt, 100);
+  for (int n = 0; n < 100; ++n)
+    integrator.step(model, reference, dt);
+  EXPECT_LE(relative_difference(fast.state(), reference, model.rest_state()), 1e-9);
+}
+
+TEST(FastExplicitStepper, DivergenceStopsWithTheStableStep) {
+  const MassSpringModel model = loaded_three_tier();
+  const double stable =
+      predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  FastExplicitStepper fast(model);
+  try {
+    for (int call = 0; call < 100; ++call)
+      fast.step(4.0 * stable, 50);
+    FAIL() << "no divergence detected";
+  } catch (const DivergenceError& error) {
+    EXPECT_NEAR(error.stable_dt() / stable, 1.0, 1e-9);
+    EXPECT_NE(std::string(error.what()).find("stable dt"), std::string::npos);
+  }
+}
+
+TEST(FastImplicitStepper, MatchesBackwardEuler) {
+  const MassSpringModel model = loaded_three_tier();
+  const double dt = 1e-3;
+  const State reference = reference_run(model, IntegratorKind::implicit_euler, dt, 30);
+  for (int threads : {1, 2}) {
+    FastImplicitStepper fast(model, FastImplicitOptions{threads, true, 1e-12, 1000});
+    for (int n = 0; n < 30; ++n)
+      fast.step(dt);
+    EXPECT_LE(relative_difference(fast.state(), reference, model.rest_state()), 1e-8) << threads;
+  }
+  // Haptic settings: loose tolerance, few iterations, still close.
+  FastImplicitStepper haptic(model, FastImplicitOptions{2, true, 1e-3, 50});
+  for (int n = 0; n < 30; ++n)
+    haptic.step(dt);
+  EXPECT_LE(relative_difference(haptic.state(), reference, model.rest_state()), 1e-2);
+  EXPECT_LE(haptic.last_cg_iterations(), 50);
+}
+
+TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
+  const MassSpringModel model = loaded_three_tier();
+  SteppingBenchmarkOptions options;
+  options.seconds_per_sample = 0.01;
+  options.samples = 3;
+  const SteppingBenchmarkResult result = run_stepping_benchmark(model, options);
+  EXPECT_EQ(result.nodes, 486);
+  EXPECT_EQ(result.springs, 4 * 480 + 2 * 162);
+  EXPECT_GT(result.explicit_steps_per_second, 0.0);
+  EXPECT_GT(result.naive_steps_per_second, 0.0);
+  EXPECT_GT(result.implicit_steps_per_second, 0.0);
+}
+
+}  // namespace
+}  // namespace msfem::massspring

@@ -1,0 +1,191 @@
+// Topology builders: node and spring counts of every variant, masses, starting stiffness.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "icosphere.hpp"
+#include "msfem/massspring/analytic_stiffness.hpp"
+#include "msfem/massspring/benchmark_cases.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/surface_geometry.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+using testing::icosphere;
+
+TEST(Icosphere, CountsFollowTheSubdivisionFormula) {
+  for (int level = 0; level <= 3; ++level) {
+    const auto mesh = icosphere(level, 1.0);
+    const int four_n = 1 << (2 * level);
+    EXPECT_EQ(mesh.vertices.rows(), 10 * four_n + 2);
+    EXPECT_EQ(mesh.triangles.rows(), 20 * four_n);
+    EXPECT_EQ(static_cast<int>(unique_edges(mesh.triangles).size()), 30 * four_n);
+    EXPECT_GT(enclosed_volume(mesh.vertices, mesh.triangles), 0.0);
+  }
+}
+
+// The layered-brain seed's test sphere: 642 vertices per tier -> 1,926 nodes and 8,964 springs.
+TEST(ThreeTier, ReproducesTheSeedSphere) {
+  const auto mesh = icosphere(3, 0.05);
+  const SpringNetwork network = build_three_tier(mesh.vertices, mesh.triangles);
+  EXPECT_EQ(network.num_nodes(), 1926);
+  EXPECT_EQ(network.num_springs(), 8964);
+  EXPECT_EQ(network.spring_group_sizes(), (std::vector<int>{1920, 1920, 3840, 642, 642}));
+  EXPECT_EQ(network.fixed_nodes.size(), 642u);
+  EXPECT_EQ(network.surface_nodes.size(), 642u);
+  EXPECT_TRUE(network.warnings.empty());
+  // Tier 2 is the surface scaled by 1/1.2, tier 3 by 1/2 about the centroid (here the origin).
+  EXPECT_NEAR(network.rest_positions.row(642 + 17).norm(), 0.05 / 1.2, 1e-12);
+  EXPECT_NEAR(network.rest_positions.row(2 * 642 + 17).norm(), 0.05 / 2.0, 1e-12);
+  // Masses lumped from the enclosed volume.
+  const double volume = enclosed_volume(mesh.vertices, mesh.triangles);
+  EXPECT_NEAR(network.masses.sum(), 1040.0 * volume, 1e-9 * 1040.0 * volume);
+  EXPECT_TRUE((network.stiffness.array() > 0.0).all());
+}
+
+TEST(ThreeTier, NormalOffsetTiersOnASphereMatchScaling) {
+  const auto mesh = icosphere(2, 0.05);
+  ThreeTierOptions options;
+  options.inner_tiers = InnerTierMethod::normal_offset;
+  const SpringNetwork network = build_three_tier(mesh.vertices, mesh.triangles, options);
+  EXPECT_EQ(network.num_nodes(), 3 * 162);
+  EXPECT_EQ(network.num_springs(), 4 * 480 + 2 * 162);
+  EXPECT_TRUE(network.warnings.empty());
+  for (int i = 0; i < 162; ++i) {
+    EXPECT_NEAR(network.rest_positions.row(162 + i).norm(), 0.05 / 1.2, 2e-4);
+    EXPECT_NEAR(network.rest_positions.row(324 + i).norm(), 0.05 / 2.0, 2e-4);
+  }
+}
+
+// Scaling a surface that is not star-shaped about its centroid pushes inner tiers outside.
+TEST(ThreeTier, DetectsInnerTierOutsideAConcaveSurface) {
+  const auto banana = testing::bent_banana(3, 0.05);
+  const SpringNetwork scaled = build_three_tier(banana.vertices, banana.triangles);
+  ASSERT_FALSE(scaled.warnings.empty());
+  EXPECT_NE(scaled.warnings.front().find("outside"), std::string::npos);
+
+  ThreeTierOptions reject;
+  reject.reject_inner_tier_outside = true;
+  EXPECT_THROW(build_three_tier(banana.vertices, banana.triangles, reject), ModelError);
+
+  ThreeTierOptions offset;
+  offset.inner_tiers = InnerTierMethod::normal_offset;
+  offset.tier2_offset = 0.004;
+  offset.tier3_offset = 0.008;
+  const SpringNetwork offset_network = build_three_tier(banana.vertices, banana.triangles, offset);
+  EXPECT_TRUE(offset_network.warnings.empty());
+}
+
+TEST(SingleLayer, SurfaceEdgesAndAnchors) {
+  const auto mesh = icosphere(3, 0.05);
+  const SpringNetwork network = build_single_layer(mesh.vertices, mesh.triangles);
+  EXPECT_EQ(network.num_nodes(), 642);
+  EXPECT_EQ(network.num_springs(), 1920);
+  EXPECT_EQ(network.num_anchors(), 642);
+  SingleLayerOptions no_anchors;
+  no_anchors.anchor_to_rest = false;
+  EXPECT_EQ(build_single_layer(mesh.vertices, mesh.triangles, no_anchors).num_anchors(), 0);
+}
+
+TEST(Skeleton, LinksEachSurfaceVertexToItsFourNearestControlPoints) {
+  const auto surface = icosphere(3, 0.05);
+  const auto control = icosphere(1, 0.05);  // stands in for a simplified surface: 42 vertices
+  SkeletonOptions options;
+  options.control_scale = 0.5;
+  const SpringNetwork network = build_skeleton(surface.vertices, surface.triangles,
+                                               control.vertices, control.triangles, options);
+  EXPECT_EQ(network.num_nodes(), 642 + 42);
+  EXPECT_EQ(network.num_springs(), 1920 + 120 + 4 * 642);
+  EXPECT_EQ(network.spring_group_sizes(), (std::vector<int>{1920, 120, 4 * 642}));
+
+  // Brute-force check of the k-d tree on every surface vertex.
+  const int links = network.spring_group_id("links");
+  for (int i = 0; i < 642; ++i) {
+    std::vector<std::pair<double, int>> by_distance;
+    for (int c = 0; c < 42; ++c)
+      by_distance.emplace_back(
+          (network.rest_positions.row(642 + c) - network.rest_positions.row(i)).squaredNorm(),
+          642 + c);
+    std::sort(by_distance.begin(), by_distance.end());
+    std::set<int> expected, linked;
+    for (int k = 0; k < 4; ++k)
+      expected.insert(by_distance[k].second);
+    for (int s = 0; s < network.num_springs(); ++s)
+      if (network.spring_group[s] == links && network.springs(s, 0) == i)
+        linked.insert(network.springs(s, 1));
+    // Ties in distance may pick either of equally near points: compare distances, not ids.
+    ASSERT_EQ(linked.size(), 4u);
+    double farthest_linked = 0.0;
+    for (int c : linked)
+      farthest_linked =
+          std::max(farthest_linked,
+                   (network.rest_positions.row(c) - network.rest_positions.row(i)).squaredNorm());
+    EXPECT_NEAR(farthest_linked, by_distance[3].first, 1e-15);
+  }
+}
+
+TEST(TetEdges, KuhnCubeCountsMassesAndStiffness) {
+  Eigen::MatrixX3d cube;
+  Eigen::MatrixX4i tets;
+  testing::kuhn_cube(cube, tets);
+  TetEdgesOptions options;
+  options.material.density = 1000.0;
+  options.material.youngs_modulus = 5000.0;
+  const SpringNetwork network = build_tet_edges(cube, tets, options);
+  EXPECT_EQ(network.num_nodes(), 8);
+  EXPECT_EQ(network.num_springs(), 19);
+  EXPECT_EQ(network.surface_triangles.rows(), 12);
+  EXPECT_EQ(network.surface_nodes.size(), 8u);
+  EXPECT_NEAR(network.masses.sum(), 1000.0, 1e-9);
+  EXPECT_GT(enclosed_volume(cube, network.surface_triangles), 0.0);  // outward boundary
+  EXPECT_NEAR(enclosed_volume(cube, network.surface_triangles), 1.0, 1e-12);
+  // The main diagonal 0-7 belongs to all six tetrahedra.
+  for (int s = 0; s < network.num_springs(); ++s)
+    if (network.springs(s, 0) == 0 && network.springs(s, 1) == 7)
+      EXPECT_NEAR(network.stiffness[s], 6.0 * lloyd_tet_edge_stiffness(5000.0, std::sqrt(3.0)),
+                  1e-9);
+
+  options.stiffness_rule = TetStiffnessRule::van_gelder;
+  const SpringNetwork gelder = build_tet_edges(cube, tets, options);
+  for (int s = 0; s < gelder.num_springs(); ++s)
+    if (gelder.springs(s, 0) == 0 && gelder.springs(s, 1) == 7)
+      EXPECT_NEAR(gelder.stiffness[s], 5000.0 * 1.0 / 3.0, 1e-9);  // E · (6 × 1/6) / 3
+}
+
+TEST(GeodesicSphere, CountsAndTheSeedSphere) {
+  for (int m : {1, 3, 8, 30}) {
+    Eigen::MatrixX3d v;
+    Eigen::MatrixX3i f;
+    geodesic_sphere(m, 0.05, v, f);
+    EXPECT_EQ(v.rows(), 10 * m * m + 2);
+    EXPECT_EQ(f.rows(), 20 * m * m);
+    EXPECT_EQ(static_cast<int>(unique_edges(f).size()), 30 * m * m);
+    const double sphere = 4.0 / 3.0 * 3.14159265358979 * 0.05 * 0.05 * 0.05;
+    EXPECT_LT(enclosed_volume(v, f), sphere);
+    if (m == 30) EXPECT_NEAR(enclosed_volume(v, f) / sphere, 1.0, 0.01);
+    EXPECT_GT(enclosed_volume(v, f), 0.0);
+  }
+  Eigen::MatrixX3d v;
+  Eigen::MatrixX3i f;
+  geodesic_sphere(8, 0.05, v, f);
+  const SpringNetwork seed = build_three_tier(v, f);
+  EXPECT_EQ(seed.num_nodes(), 1926);
+  EXPECT_EQ(seed.num_springs(), 8964);
+}
+
+TEST(AnalyticStiffness, Formulas) {
+  EXPECT_NEAR(lloyd_tet_edge_stiffness(3000.0, 0.01), 2.0 * std::sqrt(2.0) / 25.0 * 30.0, 1e-12);
+  EXPECT_NEAR(van_gelder_stiffness(3000.0, 1e-6, 0.01), 30.0, 1e-12);
+  Eigen::VectorXd lengths(2);
+  lengths << 0.01, 0.02;
+  const Eigen::VectorXd k = isotropic_network_stiffness(3000.0, 1e-6, lengths);
+  EXPECT_NEAR((k.array() * lengths.array().square()).sum(), 6.0 * 3000.0 * 1e-6, 1e-15);
+}
+
+}  // namespace
+}  // namespace msfem::massspring
