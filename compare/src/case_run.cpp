@@ -92,8 +92,12 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     run.fem = solve_fem(problem, run.mesh, tool);
     const auto curve_start = Clock::now();
     for (std::size_t i = 0; i < depths.size(); ++i) {
-      const FemSolution s = solve_fem(problem, run.mesh, at_depth(*tool, depths[i]));
-      run.fem_force_depth.push_back({depths[i], s.tool_force});
+      // The run's own depth is already solved.
+      const Eigen::Vector3d force =
+          depths[i] == tool->depth
+              ? run.fem.tool_force
+              : solve_fem(problem, run.mesh, at_depth(*tool, depths[i])).tool_force;
+      run.fem_force_depth.push_back({depths[i], force});
       progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
                        static_cast<int>(depths.size()), seconds_since(curve_start));
     }
@@ -136,6 +140,10 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     r.volume_change = cases::signed_volume(deformed) / cases::signed_volume(problem.surface) - 1.0;
     if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
     for (double depth : depths) {
+      if (depth == tool->depth) {
+        r.force_depth.push_back({depth, s.tool_force});
+        continue;
+      }
       set_tool_depth(built, problem, at_depth(*tool, depth));
       r.force_depth.push_back({depth, solve_variant_static(built).tool_force});
     }

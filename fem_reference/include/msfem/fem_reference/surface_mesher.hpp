@@ -1,0 +1,42 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "msfem/fem_reference/volume_mesh.hpp"
+
+namespace msfem::fem_reference {
+
+/// Smaller cells inside a ball (the tool's neighbourhood): `cell_size` within `radius` of `center`,
+/// growing linearly to the global size over `transition` beyond it.
+struct LocalRefinement {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  double transition = 0.0;
+  double cell_size = 0.0;
+};
+
+struct MeshOptions {
+  /// Target edge length of the interior tetrahedra in metres; 0 means the mean edge length of the
+  /// surface. Boundary triangles are never changed: their size is the surface's.
+  double cell_size = 0.0;
+  std::optional<LocalRefinement> refinement;
+  /// Gmsh's Mesh.Algorithm3D: 1 = Delaunay (default: the same mesh on every run), 10 = HXT
+  /// (several times faster on large meshes, but Gmsh 4.8's HXT differs from run to run).
+  int algorithm_3d = 1;
+};
+
+/// Throws std::invalid_argument naming the first defect unless the triangles form a closed,
+/// consistently oriented 2-manifold over existing vertices: every directed edge (a, b) appears once
+/// and its reverse (b, a) once.
+void check_closed_surface(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles);
+
+/// Tetrahedralises the volume bounded by a closed surface (metres, zero-based, counter-clockwise
+/// seen from outside) with Gmsh, keeping the surface triangulation as the mesh boundary: mesh
+/// vertex i == surface vertex i for i < vertices.rows() (no Steiner points on the boundary; a
+/// FemError is thrown if Gmsh had to add any). Throws std::invalid_argument for a non-closed
+/// surface.
+VolumeMesh mesh_closed_surface(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
+                               const MeshOptions& options = {});
+
+}  // namespace msfem::fem_reference

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <Eigen/Core>
+
+namespace msfem::fem_reference {
+
+/// Tetrahedra as four zero-based vertex ids per row, positively oriented
+/// ((v1 - v0) x (v2 - v0) . (v3 - v0) > 0, deal.II's and Gmsh's reference ordering).
+using TetrahedronArray = Eigen::Matrix<int, Eigen::Dynamic, 4, Eigen::RowMajor>;
+
+/// A tetrahedral volume mesh in plain arrays (metres), the hand-over between the Gmsh mesher and
+/// the deal.II problem. When it was built from a closed surface, its first `num_surface_vertices`
+/// vertices ARE the surface's vertices, in the surface's order and bit-identical: surface vertex i
+/// is mesh vertex i, which makes the comparison with the mass-spring surface node to node.
+struct VolumeMesh {
+  Eigen::MatrixX3d vertices;
+  TetrahedronArray tetrahedra;
+  Eigen::Index num_surface_vertices = 0;
+
+  Eigen::Index num_vertices() const { return vertices.rows(); }
+  Eigen::Index num_tetrahedra() const { return tetrahedra.rows(); }
+};
+
+/// Sum of the tetrahedra's volumes.
+double volume(const VolumeMesh& mesh);
+
+/// Mass lumped to the vertices: each tetrahedron gives density * volume / 4 to each of its
+/// vertices (kg), so a mass-spring model built on the same vertices weighs what the FEM body
+/// weighs.
+Eigen::VectorXd lumped_vertex_masses(const VolumeMesh& mesh, double density);
+
+/// Throws std::invalid_argument (one line naming the item) unless every tetrahedron refers to
+/// existing vertices and has positive volume.
+void check_volume_mesh(const VolumeMesh& mesh);
+
+}  // namespace msfem::fem_reference

@@ -1,0 +1,72 @@
+#pragma once
+
+// The deal.II side of ElasticityProblem, shared by elasticity_problem.cpp (set-up, assembly,
+// solve, reactions) and elasticity_postprocessing.cpp (evaluation, errors, output). Not installed.
+
+#include <deal.II/base/point.h>
+#include <deal.II/distributed/shared_tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/mapping_fe.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "msfem/fem_reference/elasticity_problem.hpp"
+#include "msfem/fem_reference/point_locator.hpp"
+
+namespace msfem::fem_reference::detail {
+class PetscLinearSystem;
+}
+
+namespace msfem::fem_reference {
+
+inline Eigen::Vector3d to_eigen(const dealii::Point<3>& p) {
+  return {p[0], p[1], p[2]};
+}
+
+struct ElasticityProblem::Implementation {
+  static constexpr int dim = 3;
+  using CellIterator = dealii::DoFHandler<dim>::active_cell_iterator;
+
+  Implementation(const VolumeMesh& mesh, ElasticityModel model);
+
+  // The pipeline (step-8 order).
+  void setup_system();
+  void assemble_system();
+  void solve();
+  void compute_reactions();
+
+  void locate_dof_support_points();
+  void collect_prescribed_dofs();
+  Eigen::Vector3d evaluate(const PointLocation& location) const;
+
+  MPI_Comm communicator;
+  VolumeMesh mesh;
+  ElasticityModel model;
+  dealii::parallel::shared::Triangulation<dim> triangulation;
+  dealii::FESystem<dim> fe;
+  dealii::MappingFE<dim> mapping;
+  dealii::DoFHandler<dim> dof_handler;
+  /// Active cells in the order of mesh.tetrahedra (same vertex order as the rows).
+  std::vector<CellIterator> cell_of_tetrahedron;
+
+  // Per DoF, on every rank (the shared triangulation holds every cell everywhere).
+  std::vector<dealii::Point<dim>> dof_support_points;
+  std::vector<bool> dof_on_boundary;
+  std::vector<int> dof_support;  ///< index into model.supports, or -1 for a free DoF
+  std::vector<double> prescribed_value;
+
+  std::vector<double> solution;  ///< all DoFs, gathered on every rank
+  std::vector<Eigen::Vector3d> support_reactions;
+  Eigen::Vector3d applied_load = Eigen::Vector3d::Zero();
+  SolveStatistics statistics;
+  bool solved = false;
+  std::unique_ptr<detail::PetscLinearSystem> linear_system;  ///< from setup_system to solve
+  mutable std::unique_ptr<PointLocator> locator;
+
+  ~Implementation();
+};
+
+}  // namespace msfem::fem_reference

@@ -1,0 +1,248 @@
+#include "petsc_linear_system.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+
+#include "msfem/fem_reference/errors.hpp"
+
+namespace msfem::fem_reference::detail {
+
+namespace {
+
+void check(PetscErrorCode code, const char* call) {
+  if (code != 0)
+    throw FemError(std::string("PETSc call failed: ") + call + " (error " + std::to_string(code) +
+                   ")");
+}
+#define MSFEM_PETSC(call) check((call), #call)
+
+bool mpi_initialized_here = false;
+
+/// Called by MPI_Finalize (it frees MPI_COMM_SELF's attributes first, while MPI still works), so
+/// PETSc is finalised before MPI whoever finalises MPI.
+int finalize_petsc(MPI_Comm, int, void*, void*) {
+  PetscBool finalized = PETSC_FALSE;
+  PetscFinalized(&finalized);
+  if (!finalized) PetscFinalize();
+  return MPI_SUCCESS;
+}
+
+void finalize_mpi_if_ours() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (mpi_initialized_here && !finalized) MPI_Finalize();
+}
+
+const char* reason_text(KSPConvergedReason reason) {
+  switch (reason) {
+    case KSP_DIVERGED_ITS:
+      return "iteration limit reached";
+    case KSP_DIVERGED_DTOL:
+      return "residual grew (divergence)";
+    case KSP_DIVERGED_BREAKDOWN:
+      return "breakdown";
+    case KSP_DIVERGED_INDEFINITE_PC:
+      return "indefinite preconditioner";
+    case KSP_DIVERGED_INDEFINITE_MAT:
+      return "indefinite matrix";
+    case KSP_DIVERGED_NANORINF:
+      return "NaN or Inf residual";
+    case KSP_DIVERGED_PC_FAILED:
+      return "preconditioner failed";
+    default:
+      return "not converged";
+  }
+}
+
+const char* method_name(Preconditioner p) {
+  switch (p) {
+    case Preconditioner::gamg:
+      return "CG+GAMG";
+    case Preconditioner::boomer_amg:
+      return "CG+BoomerAMG";
+    case Preconditioner::mumps:
+      return "MUMPS LU";
+  }
+  return "?";
+}
+
+}  // namespace
+
+void ensure_petsc_initialized() {
+  int mpi_ready = 0;
+  MPI_Initialized(&mpi_ready);
+  if (!mpi_ready) {
+    int provided = 0;
+    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+    mpi_initialized_here = true;
+  }
+  PetscBool petsc_ready = PETSC_FALSE;
+  PetscInitialized(&petsc_ready);
+  if (!petsc_ready) {
+    MSFEM_PETSC(PetscInitializeNoArguments());
+    int key = MPI_KEYVAL_INVALID;
+    MPI_Comm_create_keyval(MPI_COMM_NULL_COPY_FN, finalize_petsc, &key, nullptr);
+    MPI_Comm_set_attr(MPI_COMM_SELF, key, nullptr);
+  }
+  if (mpi_initialized_here) {
+    static const bool registered = (std::atexit(finalize_mpi_if_ours), true);
+    (void)registered;
+  }
+}
+
+PetscLinearSystem::PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows,
+                                     PetscInt first_owned_row, PetscInt owned_rows,
+                                     const std::vector<PetscInt>& diagonal_block_nonzeros,
+                                     const std::vector<PetscInt>& off_diagonal_block_nonzeros)
+    : communicator_(communicator), first_owned_row_(first_owned_row), owned_rows_(owned_rows) {
+  MSFEM_PETSC(MatCreate(communicator_, &matrix_));
+  MSFEM_PETSC(MatSetSizes(matrix_, owned_rows, owned_rows, global_rows, global_rows));
+  MSFEM_PETSC(MatSetType(matrix_, MATAIJ));
+  // Block size 3 before preallocation: GAMG aggregates nodes, not single DoFs.
+  MSFEM_PETSC(MatSetBlockSize(matrix_, 3));
+  MSFEM_PETSC(MatSeqAIJSetPreallocation(matrix_, 0, diagonal_block_nonzeros.data()));
+  MSFEM_PETSC(MatMPIAIJSetPreallocation(matrix_, 0, diagonal_block_nonzeros.data(), 0,
+                                        off_diagonal_block_nonzeros.data()));
+  MSFEM_PETSC(MatSetOption(matrix_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  MSFEM_PETSC(MatCreateVecs(matrix_, &solution_, &rhs_));
+  MSFEM_PETSC(VecSet(solution_, 0.0));
+  MSFEM_PETSC(VecSet(rhs_, 0.0));
+}
+
+PetscLinearSystem::~PetscLinearSystem() {
+  VecDestroy(&solution_);
+  VecDestroy(&rhs_);
+  MatDestroy(&matrix_);
+}
+
+void PetscLinearSystem::add_cell(const std::vector<PetscInt>& dofs,
+                                 const std::vector<double>& matrix,
+                                 const std::vector<double>& rhs) {
+  // Rows and columns in increasing order: PETSc's AIJ insertion then walks each row once instead
+  // of searching it for every entry (about twice as fast for P1 cells).
+  const std::size_t n = dofs.size();
+  order_.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    order_[i] = i;
+  std::sort(order_.begin(), order_.end(),
+            [&dofs](std::size_t a, std::size_t b) { return dofs[a] < dofs[b]; });
+  sorted_dofs_.resize(n);
+  sorted_matrix_.resize(n * n);
+  sorted_rhs_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    sorted_dofs_[i] = dofs[order_[i]];
+    sorted_rhs_[i] = rhs[order_[i]];
+    for (std::size_t j = 0; j < n; ++j)
+      sorted_matrix_[i * n + j] = matrix[order_[i] * n + order_[j]];
+  }
+  const PetscInt size = PetscInt(n);
+  MSFEM_PETSC(MatSetValues(matrix_, size, sorted_dofs_.data(), size, sorted_dofs_.data(),
+                           sorted_matrix_.data(), ADD_VALUES));
+  MSFEM_PETSC(VecSetValues(rhs_, size, sorted_dofs_.data(), sorted_rhs_.data(), ADD_VALUES));
+}
+
+void PetscLinearSystem::finish_assembly() {
+  MSFEM_PETSC(MatAssemblyBegin(matrix_, MAT_FINAL_ASSEMBLY));
+  MSFEM_PETSC(MatAssemblyEnd(matrix_, MAT_FINAL_ASSEMBLY));
+  MSFEM_PETSC(VecAssemblyBegin(rhs_));
+  MSFEM_PETSC(VecAssemblyEnd(rhs_));
+  MSFEM_PETSC(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
+}
+
+void PetscLinearSystem::apply_prescribed_values(const std::vector<PetscInt>& rows,
+                                                const std::vector<double>& values) {
+  Vec diagonal = nullptr;
+  MSFEM_PETSC(MatCreateVecs(matrix_, &diagonal, nullptr));
+  MSFEM_PETSC(MatGetDiagonal(matrix_, diagonal));
+  PetscReal diagonal_sum = 0.0;
+  MSFEM_PETSC(VecNorm(diagonal, NORM_1, &diagonal_sum));
+  VecDestroy(&diagonal);
+  PetscInt global_rows = 0;
+  MSFEM_PETSC(MatGetSize(matrix_, &global_rows, nullptr));
+  const double mean_diagonal = diagonal_sum / double(global_rows);
+
+  MSFEM_PETSC(
+      VecSetValues(solution_, PetscInt(rows.size()), rows.data(), values.data(), INSERT_VALUES));
+  MSFEM_PETSC(VecAssemblyBegin(solution_));
+  MSFEM_PETSC(VecAssemblyEnd(solution_));
+  // b -= A(:, rows) x(rows); rows and columns zeroed; b(rows) = diag * x(rows).
+  MSFEM_PETSC(MatZeroRowsColumns(matrix_, PetscInt(rows.size()), rows.data(), mean_diagonal,
+                                 solution_, rhs_));
+}
+
+KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
+                                      const std::vector<double>& owned_node_coordinates) {
+  KSP ksp = nullptr;
+  MSFEM_PETSC(KSPCreate(communicator_, &ksp));
+  MSFEM_PETSC(KSPSetOperators(ksp, matrix_, matrix_));
+  PC pc = nullptr;
+  MSFEM_PETSC(KSPGetPC(ksp, &pc));
+  MatNullSpace rigid_body_modes = nullptr;
+  Vec coordinates = nullptr;
+  if (settings.preconditioner == Preconditioner::mumps) {
+    MSFEM_PETSC(KSPSetType(ksp, KSPPREONLY));
+    MSFEM_PETSC(PCSetType(pc, PCLU));
+    MSFEM_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  } else {
+    MSFEM_PETSC(KSPSetType(ksp, KSPCG));
+    MSFEM_PETSC(
+        KSPSetTolerances(ksp, settings.relative_tolerance, 1e-300, 1e10, settings.max_iterations));
+    // The three translations and three rotations, built by PETSc from the node coordinates
+    // (block size 3): the near-null space that makes smoothed aggregation work for elasticity.
+    MSFEM_PETSC(VecCreateMPI(communicator_, owned_rows_, PETSC_DETERMINE, &coordinates));
+    MSFEM_PETSC(VecSetBlockSize(coordinates, 3));
+    double* c = nullptr;
+    MSFEM_PETSC(VecGetArray(coordinates, &c));
+    for (PetscInt i = 0; i < owned_rows_; ++i)
+      c[i] = owned_node_coordinates[std::size_t(i)];
+    MSFEM_PETSC(VecRestoreArray(coordinates, &c));
+    MSFEM_PETSC(MatNullSpaceCreateRigidBody(coordinates, &rigid_body_modes));
+    MSFEM_PETSC(MatSetNearNullSpace(matrix_, rigid_body_modes));
+    if (settings.preconditioner == Preconditioner::gamg) {
+      MSFEM_PETSC(PCSetType(pc, PCGAMG));
+    } else {
+      MSFEM_PETSC(PCSetType(pc, PCHYPRE));
+      MSFEM_PETSC(PCHYPRESetType(pc, "boomeramg"));
+      // 3D elasticity: a stronger threshold than hypre's 2D default 0.25.
+      MSFEM_PETSC(PetscOptionsSetValue(nullptr, "-pc_hypre_boomeramg_strong_threshold", "0.7"));
+    }
+    MSFEM_PETSC(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
+  }
+  MSFEM_PETSC(KSPSetFromOptions(ksp));
+  const PetscErrorCode solve_code = KSPSolve(ksp, rhs_, solution_);
+  KSPConvergedReason reason;
+  KSPGetConvergedReason(ksp, &reason);
+  PetscInt iterations = 0;
+  KSPGetIterationNumber(ksp, &iterations);
+  PetscReal residual = 0.0;
+  KSPGetResidualNorm(ksp, &residual);
+  KSPDestroy(&ksp);
+  MatNullSpaceDestroy(&rigid_body_modes);
+  VecDestroy(&coordinates);
+  if (solve_code != 0 || reason < 0)
+    throw SolverError(std::string(method_name(settings.preconditioner)) + " did not converge: " +
+                      reason_text(reason) + " after " + std::to_string(iterations) +
+                      " iterations, residual norm " + std::to_string(residual) +
+                      " (relative tolerance " + std::to_string(settings.relative_tolerance) + ")");
+  return {int(iterations), double(residual)};
+}
+
+std::vector<double> PetscLinearSystem::gathered_solution() const {
+  VecScatter scatter = nullptr;
+  Vec all = nullptr;
+  MSFEM_PETSC(VecScatterCreateToAll(solution_, &scatter, &all));
+  MSFEM_PETSC(VecScatterBegin(scatter, solution_, all, INSERT_VALUES, SCATTER_FORWARD));
+  MSFEM_PETSC(VecScatterEnd(scatter, solution_, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscInt size = 0;
+  MSFEM_PETSC(VecGetSize(all, &size));
+  const double* values = nullptr;
+  MSFEM_PETSC(VecGetArrayRead(all, &values));
+  std::vector<double> result(values, values + size);
+  MSFEM_PETSC(VecRestoreArrayRead(all, &values));
+  VecScatterDestroy(&scatter);
+  VecDestroy(&all);
+  return result;
+}
+
+}  // namespace msfem::fem_reference::detail

@@ -1,0 +1,64 @@
+#pragma once
+
+#include <mpi.h>
+#include <petscksp.h>
+
+#include <vector>
+
+#include "msfem/fem_reference/elasticity_problem.hpp"
+
+namespace msfem::fem_reference::detail {
+
+/// Initialises MPI and PETSc unless the program already did (deal.II's MPI_InitFinalize, a test's
+/// main); what this function initialised is finalised at exit.
+void ensure_petsc_initialized();
+
+struct KrylovReport {
+  int iterations = 0;
+  double residual_norm = 0.0;
+};
+
+/// The distributed stiffness system K u = f in raw PETSc, for what deal.II 9.4 does not wrap:
+/// block size 3 (DoFs interleaved x, y, z per node) and the rigid-body near-null space for GAMG,
+/// symmetric elimination of prescribed DoFs (MatZeroRowsColumns) and the KSP set-up. Each rank owns
+/// the contiguous rows [first_owned_row, first_owned_row + owned_rows).
+class PetscLinearSystem {
+ public:
+  PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows, PetscInt first_owned_row,
+                    PetscInt owned_rows, const std::vector<PetscInt>& diagonal_block_nonzeros,
+                    const std::vector<PetscInt>& off_diagonal_block_nonzeros);
+  ~PetscLinearSystem();
+  PetscLinearSystem(const PetscLinearSystem&) = delete;
+  PetscLinearSystem& operator=(const PetscLinearSystem&) = delete;
+
+  /// Adds a dense cell matrix (row-major) and cell vector at the given global DoFs.
+  void add_cell(const std::vector<PetscInt>& dofs, const std::vector<double>& matrix,
+                const std::vector<double>& rhs);
+  void finish_assembly();
+
+  /// Eliminates the prescribed DoFs symmetrically: u_i = value_i, the columns moved to the
+  /// right-hand side, the diagonal set to the matrix's mean diagonal so the preconditioner sees a
+  /// well-scaled row. `rows` are this rank's owned prescribed rows.
+  void apply_prescribed_values(const std::vector<PetscInt>& rows,
+                               const std::vector<double>& values);
+
+  /// Solves with the chosen method; `owned_node_coordinates` holds x, y, z of the node of each
+  /// owned DoF triple (for the rigid-body modes). Throws SolverError when not converged.
+  KrylovReport solve(const SolverSettings& settings,
+                     const std::vector<double>& owned_node_coordinates);
+
+  /// The whole solution on every rank.
+  std::vector<double> gathered_solution() const;
+
+ private:
+  MPI_Comm communicator_;
+  PetscInt first_owned_row_, owned_rows_;
+  Mat matrix_ = nullptr;
+  Vec rhs_ = nullptr, solution_ = nullptr;
+  // Scratch of add_cell.
+  std::vector<std::size_t> order_;
+  std::vector<PetscInt> sorted_dofs_;
+  std::vector<double> sorted_matrix_, sorted_rhs_;
+};
+
+}  // namespace msfem::fem_reference::detail

@@ -1,0 +1,102 @@
+#include "msfem/fem_reference/surface_mesher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "msfem/fem_reference/shape_mesher.hpp"
+#include "test_surfaces.hpp"
+
+namespace msfem::fem_reference {
+namespace {
+
+double enclosed_volume(const testing::TestSurface& s) {
+  double v = 0.0;
+  for (Eigen::Index t = 0; t < s.triangles.rows(); ++t) {
+    const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)),
+                          b = s.vertices.row(s.triangles(t, 1)),
+                          c = s.vertices.row(s.triangles(t, 2));
+    v += a.dot(b.cross(c)) / 6.0;
+  }
+  return v;
+}
+
+TEST(SurfaceMesher, KeepsEverySurfaceVertexAsMeshVertex) {
+  const testing::TestSurface sphere = testing::icosphere(3, 0.05);
+  const VolumeMesh mesh = mesh_closed_surface(sphere.vertices, sphere.triangles);
+  ASSERT_EQ(mesh.num_surface_vertices, sphere.vertices.rows());
+  EXPECT_GT(mesh.num_vertices(), sphere.vertices.rows());
+  // Surface vertex i is mesh vertex i, bit for bit: the node-to-node map is the identity.
+  EXPECT_EQ(mesh.vertices.topRows(sphere.vertices.rows()), sphere.vertices);
+  // The boundary faces are the surface triangles: the polyhedral volume is the surface's.
+  EXPECT_NEAR(volume(mesh), enclosed_volume(sphere), 1e-12 * enclosed_volume(sphere));
+  // Every surface vertex is used by a tetrahedron, and no interior vertex lies on the surface.
+  std::set<int> used(mesh.tetrahedra.data(), mesh.tetrahedra.data() + mesh.tetrahedra.size());
+  for (int i = 0; i < sphere.vertices.rows(); ++i)
+    EXPECT_TRUE(used.count(i)) << i;
+  for (Eigen::Index i = sphere.vertices.rows(); i < mesh.num_vertices(); ++i)
+    EXPECT_LT(mesh.vertices.row(i).norm(), 0.05 * (1 - 1e-6));
+  EXPECT_NO_THROW(check_volume_mesh(mesh));
+  const Eigen::VectorXd masses = lumped_vertex_masses(mesh, 1040.0);
+  EXPECT_NEAR(masses.sum(), 1040.0 * volume(mesh), 1e-12 * masses.sum());
+  EXPECT_GT(masses.minCoeff(), 0.0);
+}
+
+TEST(SurfaceMesher, RefinesNearTheTool) {
+  const testing::TestSurface sphere = testing::icosphere(2, 0.05);
+  MeshOptions options;
+  options.cell_size = 0.01;
+  const VolumeMesh coarse = mesh_closed_surface(sphere.vertices, sphere.triangles, options);
+  options.refinement = LocalRefinement{Eigen::Vector3d(0, 0, 0.04), 0.01, 0.01, 0.003};
+  const VolumeMesh refined = mesh_closed_surface(sphere.vertices, sphere.triangles, options);
+  auto count_near = [](const VolumeMesh& m) {
+    int n = 0;
+    for (Eigen::Index i = 0; i < m.num_vertices(); ++i)
+      n += (m.vertices.row(i) - Eigen::RowVector3d(0, 0, 0.04)).norm() < 0.015;
+    return n;
+  };
+  EXPECT_GT(count_near(refined), 2 * count_near(coarse));
+  EXPECT_EQ(refined.vertices.topRows(sphere.vertices.rows()), sphere.vertices);
+}
+
+TEST(SurfaceMesher, RejectsOpenOrInconsistentSurfaces) {
+  testing::TestSurface sphere = testing::icosphere(1, 1.0);
+  testing::TestSurface open = sphere;
+  open.triangles.conservativeResize(open.triangles.rows() - 1, 3);
+  EXPECT_THROW(mesh_closed_surface(open.vertices, open.triangles), std::invalid_argument);
+  testing::TestSurface flipped = sphere;
+  std::swap(flipped.triangles(0, 1), flipped.triangles(0, 2));
+  EXPECT_THROW(mesh_closed_surface(flipped.vertices, flipped.triangles), std::invalid_argument);
+  testing::TestSurface out_of_range = sphere;
+  out_of_range.triangles(3, 2) = 1000;
+  EXPECT_THROW(check_closed_surface(out_of_range.vertices, out_of_range.triangles),
+               std::invalid_argument);
+  try {
+    check_closed_surface(open.vertices, open.triangles);
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("not closed"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ShapeMesher, MeshesExactShapesAndRefines) {
+  const VolumeMesh box = mesh_box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0.2), 0.05);
+  EXPECT_NEAR(volume(box), 0.02, 1e-12);
+  const double octant = M_PI / 6 * (1 - 0.125);
+  const VolumeMesh coarse = mesh_hollow_sphere(0.5, 1.0, 0.2, true);
+  const VolumeMesh fine = mesh_hollow_sphere(0.5, 1.0, 0.1, true);
+  EXPECT_GT(fine.num_tetrahedra(), 3 * coarse.num_tetrahedra());
+  EXPECT_NEAR(volume(fine), octant, 0.01 * octant);
+  EXPECT_LT(std::abs(volume(fine) - octant), std::abs(volume(coarse) - octant));
+  for (Eigen::Index i = 0; i < fine.num_vertices(); ++i) {
+    EXPECT_GE(fine.vertices.row(i).minCoeff(), -1e-12);
+    EXPECT_LE(fine.vertices.row(i).norm(), 1.0 + 1e-9);
+    EXPECT_GE(fine.vertices.row(i).norm(), 0.5 - 1e-9);
+  }
+  EXPECT_THROW(mesh_hollow_sphere(1.0, 0.5, 0.1, false), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace msfem::fem_reference
