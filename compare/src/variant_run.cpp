@@ -171,7 +171,7 @@ StaticSolution solve_variant_static(const BuiltVariant& variant) {
   const auto start = Clock::now();
   ms::StaticOptions options;
   // A sparse factorisation's fill-in grows quickly with the brain-scale networks; CG does not.
-  if (model.num_nodes() > 5000) options.linear_solver = ms::StaticLinearSolver::cg;
+  if (model.num_nodes() > 500000) options.linear_solver = ms::StaticLinearSolver::cg;
   const ms::StaticResult r = ms::solve_static(model, options);
   StaticSolution solution;
   solution.solve_time_s = seconds_since(start);
