@@ -13,6 +13,7 @@
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface_generators.hpp"
 
 namespace msfem::cases {
 namespace {
@@ -145,7 +146,7 @@ void declare_fem_timing_output(ParameterHandler& prm) {
       "Integrator whose steps are timed.");
   prm.declare_entry("dt", "0", Patterns::Double(0),
                     "Time step (s); 0: half the estimated stable step of each variant.");
-  prm.declare_entry("steps", "2000", Patterns::Integer(1), "Dynamic steps timed.");
+  prm.declare_entry("steps", "2000", Patterns::Integer(1, 100000000), "Dynamic steps timed.");
   prm.leave_subsection();
   prm.enter_subsection("output");
   prm.declare_entry("directory", "results/runs", Patterns::Anything(),
@@ -304,11 +305,12 @@ CaseParameters extract(ParameterHandler& prm) {
     throw InputError("mass spring/three tier: inner tier scale must exceed middle tier scale");
 
   prm.enter_subsection("fem");
-  c.fem = {prm.get_integer("degree"), prm.get_double("cell size"), prm.get("solver"),
-           prm.get_double("relative tolerance")};
+  c.fem = {static_cast<int>(prm.get_integer("degree")), prm.get_double("cell size"),
+           prm.get("solver"), prm.get_double("relative tolerance")};
   prm.leave_subsection();
   prm.enter_subsection("timing");
-  c.timing = {prm.get("integrator"), prm.get_double("dt"), prm.get_integer("steps")};
+  c.timing = {prm.get("integrator"), prm.get_double("dt"),
+              static_cast<int>(prm.get_integer("steps"))};
   prm.leave_subsection();
   prm.enter_subsection("output");
   c.output.directory = prm.get("directory");
@@ -340,7 +342,7 @@ CaseParameters read_case(const std::filesystem::path& file,
   c.file = file;
   c.name = file.stem().string();
   // A relative surface path is relative to the case file, so cases run from any folder.
-  if (c.geometry.source.find(':') == std::string::npos) {
+  if (!is_surface_generator(c.geometry.source)) {
     const std::filesystem::path p(c.geometry.source);
     if (p.is_relative()) c.geometry.source = (file.parent_path() / p).lexically_normal().string();
   }

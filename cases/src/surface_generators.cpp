@@ -104,6 +104,10 @@ int parse_level(const std::string& spec, const std::string& text) {
 
 }  // namespace
 
+bool is_surface_generator(const std::string& source) {
+  return source.rfind("icosphere:", 0) == 0 || source.rfind("ellipsoid:", 0) == 0;
+}
+
 Surface generate_surface(const std::string& spec) {
   const auto parts = split(spec, ':');
   if (!parts.empty() && parts[0] == "icosphere" && (parts.size() == 2 || parts.size() == 3)) {

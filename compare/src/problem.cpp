@@ -13,14 +13,10 @@
 namespace msfem::compare {
 namespace {
 
-bool is_generator(const std::string& source) {
-  return source.rfind("icosphere:", 0) == 0 || source.rfind("ellipsoid:", 0) == 0;
-}
-
 cases::Surface load_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
   const auto& g = p.geometry;
-  cases::Surface s = is_generator(g.source) ? cases::generate_surface(g.source)
-                                            : cases::read_surface(g.source, g.unit);
+  cases::Surface s = cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
+                                                           : cases::read_surface(g.source, g.unit);
   if (g.simplify_to_vertices > 0 && g.simplify_to_vertices < s.num_vertices()) {
     const auto before = s.num_vertices();
     try {

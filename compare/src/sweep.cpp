@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/compare/case_run.hpp"
 #include "msfem/compare/run_outputs.hpp"
@@ -12,12 +13,8 @@
 namespace msfem::compare {
 namespace {
 
-bool is_generator(const std::string& source) {
-  return source.rfind("icosphere:", 0) == 0 || source.rfind("ellipsoid:", 0) == 0;
-}
-
 std::vector<int> default_resolutions(const cases::CaseParameters& p) {
-  if (is_generator(p.geometry.source)) return {2, 3, 4, 5};
+  if (cases::is_surface_generator(p.geometry.source)) return {2, 3, 4, 5};
   const int available =
       static_cast<int>(cases::read_surface(p.geometry.source, p.geometry.unit).num_vertices());
   std::vector<int> r;
@@ -29,7 +26,7 @@ std::vector<int> default_resolutions(const cases::CaseParameters& p) {
 
 // The case at one resolution: the icosphere level replaced, or the simplification target set.
 cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
-  if (is_generator(p.geometry.source)) {
+  if (cases::is_surface_generator(p.geometry.source)) {
     const auto first = p.geometry.source.find(':');
     const auto second = p.geometry.source.find(':', first + 1);
     p.geometry.source = p.geometry.source.substr(0, first + 1) + std::to_string(resolution) +

@@ -23,4 +23,7 @@ Surface ellipsoid(int level, const Eigen::Vector3d& semi_axes,
 /// spec and what is wrong with it.
 Surface generate_surface(const std::string& spec);
 
+/// Whether a case's geometry source names a generator (as opposed to a surface file).
+bool is_surface_generator(const std::string& source);
+
 }  // namespace msfem::cases
