@@ -27,6 +27,10 @@ const std::vector<CommandEntry>& commands() {
       {"sweep", sweep_command,
        "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
        "      variants x resolutions x integrators: sweep.json, table and Pareto plot"},
+      {"regress", regress_command,
+       "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]...\n"
+       "      compare runs with committed baselines; exit 1 on a worse metric or field, a missing\n"
+       "      or stale baseline, or a non-finite value"},
       {"params", params_command, "params\n      print the whole case-file language"},
       {"mesh-info", mesh_info_command,
        "mesh-info FILE [--unit m|cm|mm] [--json] [--no-self-intersections]\n"

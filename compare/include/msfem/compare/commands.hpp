@@ -15,8 +15,10 @@ int mesh_info_command(const Arguments& args);  // msfem mesh-info FILE [--unit m
 int simplify_command(const Arguments& args);   // msfem simplify IN OUT --vertices N [--smooth K]
 int run_command(const Arguments& args);        // msfem run CASE.prm [--out DIR] [--set K=V]...
 int params_command(const Arguments& args);     // msfem params
-int sweep_command(const Arguments& args);   // msfem sweep CASE.prm [--resolutions ...]
+int sweep_command(const Arguments& args);      // msfem sweep CASE.prm [--resolutions ...]
 int bench_command(const Arguments& args);      // msfem bench massspring|fem [--json]
-int verify_command(const Arguments& args);     // msfem verify [--json]
+int verify_command(const Arguments& args);
+int regress_command(const Arguments& args);  // msfem regress [--baselines DIR] [CASE...] [--update]
+                                             // // msfem verify [--json]
 
 }  // namespace msfem::compare

@@ -1,0 +1,226 @@
+#include "msfem/compare/regression.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "msfem/compare/run_outputs.hpp"
+
+namespace msfem::compare {
+namespace {
+
+constexpr int format_version = 1;
+// Default tolerances written into a new baseline (numdiff style: |now − base| <= abs + rel |base|).
+constexpr double metric_abs_tol = 1e-9, metric_rel_tol = 1e-3;
+constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the largest |u| there
+
+std::string hex(std::uint64_t h) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 14695981039346656037ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i)
+    h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+double metric_value(const VariantResult& v, const std::string& metric) {
+  if (metric == "rel_l2_error") return v.errors.all.rel_l2_error;
+  if (metric == "max_error_m") return v.errors.all.max_error_m;
+  if (metric == "reaction_force_rel_error") return v.reaction_force_rel_error;
+  return v.volume_change;
+}
+
+std::string number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+
+bool finite(const nlohmann::json& j) {
+  return j.is_number() && std::isfinite(j.get<double>());
+}
+
+void compare_metric(const std::string& case_name, const VariantResult& v, const std::string& metric,
+                    const nlohmann::json& base, std::vector<RegressionRow>& rows) {
+  RegressionRow row{case_name, v.name, metric, "-", number(metric_value(v, metric)), "-", "ok"};
+  const double now = metric_value(v, metric);
+  if (!base.contains(metric)) {
+    row.status = "MISSING";
+    rows.push_back(row);
+    return;
+  }
+  const auto& b = base.at(metric);
+  if (!finite(b.value("value", nlohmann::json())) || !std::isfinite(now)) {
+    row.status = "NON-FINITE";
+    rows.push_back(row);
+    return;
+  }
+  const double value = b.at("value"), abs_tol = b.at("abs_tol"), rel_tol = b.at("rel_tol");
+  const bool magnitude = metric == "volume_change";
+  const double base_v = magnitude ? std::abs(value) : value,
+               now_v = magnitude ? std::abs(now) : now;
+  const double tol = abs_tol + rel_tol * std::abs(value);
+  row.baseline = number(value);
+  row.tolerance = number(tol);
+  if (now_v > base_v + tol) row.status = "WORSE";
+  if (now_v < base_v - tol) row.status = "improved";
+  rows.push_back(row);
+}
+
+void compare_field(const std::string& case_name, const VariantResult& v, const nlohmann::json& base,
+                   std::vector<RegressionRow>& rows) {
+  RegressionRow row{case_name, v.name, "surface_displacement", "-", "-", "-", "ok"};
+  if (!base.contains("field")) {
+    row.status = "MISSING";
+    rows.push_back(row);
+    return;
+  }
+  const auto& f = base.at("field");
+  const auto& data = f.at("data");
+  const Eigen::Index n = v.surface_displacement.rows();
+  if (static_cast<Eigen::Index>(data.size()) != 3 * n) {
+    row.baseline = std::to_string(data.size() / 3) + " vertices";
+    row.now = std::to_string(n) + " vertices";
+    row.status = "STALE";
+    rows.push_back(row);
+    return;
+  }
+  double max_base = 0, max_diff = 0;
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const auto& b = data.at(static_cast<std::size_t>(3 * i + c));
+      const double now = v.surface_displacement(i, c);
+      if (!finite(b) || !std::isfinite(now)) {
+        row.status = "NON-FINITE";
+        row.baseline = "vertex " + std::to_string(i);
+        rows.push_back(row);
+        return;
+      }
+      max_base = std::max(max_base, std::abs(b.get<double>()));
+      max_diff = std::max(max_diff, std::abs(now - b.get<double>()));
+    }
+  const double tol = f.at("abs_tol_m").get<double>() + f.at("rel_tol").get<double>() * max_base;
+  row.baseline = "max |u| " + number(max_base);
+  row.now = "max diff " + number(max_diff);
+  row.tolerance = number(tol);
+  if (max_diff > tol) row.status = "WORSE";
+  rows.push_back(row);
+}
+
+}  // namespace
+
+const std::vector<std::string>& regression_metrics() {
+  static const std::vector<std::string> names = {"rel_l2_error", "max_error_m",
+                                                 "reaction_force_rel_error", "volume_change"};
+  return names;
+}
+
+std::string file_hash(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return hex(fnv1a(bytes.data(), bytes.size()));
+}
+
+std::string surface_hash(const cases::Surface& s) {
+  std::uint64_t h =
+      fnv1a(s.vertices.data(), sizeof(double) * static_cast<std::size_t>(s.vertices.size()));
+  h = fnv1a(s.triangles.data(), sizeof(int) * static_cast<std::size_t>(s.triangles.size()), h);
+  return hex(h);
+}
+
+nlohmann::json make_baseline(const CaseRun& run) {
+  const auto& p = run.problem.parameters;
+  char date[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  nlohmann::json variants = nlohmann::json::object();
+  for (const auto& v : run.variants) {
+    nlohmann::json metrics = nlohmann::json::object();
+    for (const auto& m : regression_metrics())
+      metrics[m] = {
+          {"value", metric_value(v, m)}, {"abs_tol", metric_abs_tol}, {"rel_tol", metric_rel_tol}};
+    std::vector<double> data;
+    for (Eigen::Index i = 0; i < v.surface_displacement.rows(); ++i)
+      for (int c = 0; c < 3; ++c)
+        data.push_back(v.surface_displacement(i, c));
+    variants[v.name] = {{"metrics", metrics},
+                        {"field",
+                         {{"name", "surface_displacement"},
+                          {"units", "m"},
+                          {"layout", "vertex-major x, y, z"},
+                          {"abs_tol_m", field_abs_tol_m},
+                          {"rel_tol", field_rel_tol},
+                          {"data", data}}}};
+  }
+  return {{"format_version", format_version},
+          {"case", p.name},
+          {"case_file", p.file.lexically_normal().string()},
+          {"case_file_hash", file_hash(p.file)},
+          {"mesh_hash", surface_hash(run.problem.surface)},
+          {"units", {{"length", "m"}}},
+          {"degree", p.fem.degree},
+          {"git_revision", git_revision()},
+          {"date", date},
+          {"variants", variants}};
+}
+
+std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohmann::json& base) {
+  const auto& p = run.problem.parameters;
+  std::vector<RegressionRow> rows;
+  auto header = [&](const std::string& what, const std::string& b, const std::string& now) {
+    rows.push_back({p.name, "-", what, b, now, "-", "STALE"});
+  };
+  if (base.value("format_version", 0) != format_version) {
+    header("format_version", base.value("format_version", nlohmann::json()).dump(),
+           std::to_string(format_version));
+    return rows;
+  }
+  if (base.value("case_file_hash", "") != file_hash(p.file))
+    header("case_file_hash (stale baseline, run --update)", base.value("case_file_hash", ""),
+           file_hash(p.file));
+  if (base.value("mesh_hash", "") != surface_hash(run.problem.surface))
+    header("mesh_hash (stale baseline, run --update)", base.value("mesh_hash", ""),
+           surface_hash(run.problem.surface));
+  if (!rows.empty()) return rows;
+  const auto& variants = base.at("variants");
+  for (const auto& v : run.variants) {
+    if (!variants.contains(v.name)) {
+      rows.push_back({p.name, v.name, "baseline", "-", "present", "-", "MISSING"});
+      continue;
+    }
+    for (const auto& m : regression_metrics())
+      compare_metric(p.name, v, m, variants.at(v.name).at("metrics"), rows);
+    compare_field(p.name, v, variants.at(v.name), rows);
+  }
+  for (const auto& [name, unused] : variants.items()) {
+    bool ran = false;
+    for (const auto& v : run.variants)
+      ran = ran || v.name == name;
+    if (!ran) rows.push_back({p.name, name, "run", "present", "-", "-", "MISSING"});
+  }
+  return rows;
+}
+
+std::string regression_table(const std::vector<RegressionRow>& rows) {
+  std::ostringstream out;
+  char line[512];
+  std::snprintf(line, sizeof line, "%-20s %-13s %-46s %-18s %-18s %-11s %s\n", "case", "variant",
+                "metric", "baseline", "now", "tolerance", "status");
+  out << line;
+  for (const auto& r : rows) {
+    std::snprintf(line, sizeof line, "%-20s %-13s %-46s %-18s %-18s %-11s %s\n",
+                  r.case_name.c_str(), r.variant.c_str(), r.metric.c_str(), r.baseline.c_str(),
+                  r.now.c_str(), r.tolerance.c_str(), r.status.c_str());
+    out << line;
+  }
+  return out.str();
+}
+
+}  // namespace msfem::compare
