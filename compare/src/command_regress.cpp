@@ -77,14 +77,12 @@ int regress_command(const Arguments& args) {
     if (opt.flag("update")) {
       const nlohmann::json old =
           std::filesystem::exists(baseline_file) ? read_baseline(baseline_file) : nlohmann::json();
-      const nlohmann::json fresh = make_baseline(run);
-      std::filesystem::create_directories(dir);
-      write_text_atomically(baseline_file, fresh.dump(1) + "\n");
+      const nlohmann::json fresh = write_baseline(run, dir);
       std::cout << "updated " << baseline_file.string() << ":\n";
       print_changes(old, fresh);
       continue;
     }
-    const auto compared = compare_with_baseline(run, read_baseline(baseline_file));
+    const auto compared = compare_with_baseline(run, read_baseline(baseline_file), dir);
     rows.insert(rows.end(), compared.begin(), compared.end());
   }
   if (opt.flag("update")) return 0;

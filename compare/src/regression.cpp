@@ -7,15 +7,17 @@
 #include <iterator>
 #include <sstream>
 
+#include "msfem/compare/atomic_file.hpp"
+#include "msfem/compare/result_writers.hpp"
 #include "msfem/compare/run_outputs.hpp"
 
 namespace msfem::compare {
 namespace {
 
-constexpr int format_version = 1;
+constexpr int format_version = 2;
 // Default tolerances written into a new baseline (numdiff style: |now − base| <= abs + rel |base|).
 constexpr double metric_abs_tol = 1e-9, metric_rel_tol = 1e-3;
-constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the largest |u| there
+constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the largest |u|
 
 std::string hex(std::uint64_t h) {
   char text[17];
@@ -75,37 +77,36 @@ void compare_metric(const std::string& case_name, const VariantResult& v, const 
 }
 
 void compare_field(const std::string& case_name, const VariantResult& v, const nlohmann::json& base,
-                   std::vector<RegressionRow>& rows) {
+                   const std::filesystem::path& fields_file, std::vector<RegressionRow>& rows) {
   RegressionRow row{case_name, v.name, "surface_displacement", "-", "-", "-", "ok"};
-  if (!base.contains("field")) {
+  Eigen::MatrixXd reference;
+  try {
+    const auto& f = base.at("field");
+    reference = read_h5_matrix(fields_file, f.at("dataset").get<std::string>());
+  } catch (const std::exception& e) {
+    row.baseline = fields_file.filename().string();
     row.status = "MISSING";
     rows.push_back(row);
     return;
   }
-  const auto& f = base.at("field");
-  const auto& data = f.at("data");
   const Eigen::Index n = v.surface_displacement.rows();
-  if (static_cast<Eigen::Index>(data.size()) != 3 * n) {
-    row.baseline = std::to_string(data.size() / 3) + " vertices";
+  if (reference.rows() != n || reference.cols() != 3) {
+    row.baseline = std::to_string(reference.rows()) + " vertices";
     row.now = std::to_string(n) + " vertices";
     row.status = "STALE";
     rows.push_back(row);
     return;
   }
-  double max_base = 0, max_diff = 0;
   for (Eigen::Index i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      const auto& b = data.at(static_cast<std::size_t>(3 * i + c));
-      const double now = v.surface_displacement(i, c);
-      if (!finite(b) || !std::isfinite(now)) {
-        row.status = "NON-FINITE";
-        row.baseline = "vertex " + std::to_string(i);
-        rows.push_back(row);
-        return;
-      }
-      max_base = std::max(max_base, std::abs(b.get<double>()));
-      max_diff = std::max(max_diff, std::abs(now - b.get<double>()));
+    if (!reference.row(i).allFinite() || !v.surface_displacement.row(i).allFinite()) {
+      row.baseline = "vertex " + std::to_string(i);
+      row.status = "NON-FINITE";
+      rows.push_back(row);
+      return;
     }
+  const double max_base = reference.rowwise().norm().maxCoeff();
+  const double max_diff = (v.surface_displacement - reference).cwiseAbs().maxCoeff();
+  const auto& f = base.at("field");
   const double tol = f.at("abs_tol_m").get<double>() + f.at("rel_tol").get<double>() * max_base;
   row.baseline = "max |u| " + number(max_base);
   row.now = "max diff " + number(max_diff);
@@ -135,43 +136,48 @@ std::string surface_hash(const cases::Surface& s) {
   return hex(h);
 }
 
-nlohmann::json make_baseline(const CaseRun& run) {
+nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& directory) {
   const auto& p = run.problem.parameters;
   char date[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  const std::string fields_file = p.name + ".fields.h5";
   nlohmann::json variants = nlohmann::json::object();
+  std::vector<VariantField> fields;
   for (const auto& v : run.variants) {
     nlohmann::json metrics = nlohmann::json::object();
     for (const auto& m : regression_metrics())
       metrics[m] = {
           {"value", metric_value(v, m)}, {"abs_tol", metric_abs_tol}, {"rel_tol", metric_rel_tol}};
-    std::vector<double> data;
-    for (Eigen::Index i = 0; i < v.surface_displacement.rows(); ++i)
-      for (int c = 0; c < 3; ++c)
-        data.push_back(v.surface_displacement(i, c));
     variants[v.name] = {{"metrics", metrics},
                         {"field",
-                         {{"name", "surface_displacement"},
+                         {{"dataset", "/variants/" + v.name + "/displacement"},
                           {"units", "m"},
-                          {"layout", "vertex-major x, y, z"},
                           {"abs_tol_m", field_abs_tol_m},
-                          {"rel_tol", field_rel_tol},
-                          {"data", data}}}};
+                          {"rel_tol", field_rel_tol}}}};
+    fields.push_back({v.name, v.surface_displacement, v.error});
   }
-  return {{"format_version", format_version},
-          {"case", p.name},
-          {"case_file", p.file.lexically_normal().string()},
-          {"case_file_hash", file_hash(p.file)},
-          {"mesh_hash", surface_hash(run.problem.surface)},
-          {"units", {{"length", "m"}}},
-          {"degree", p.fem.degree},
-          {"git_revision", git_revision()},
-          {"date", date},
-          {"variants", variants}};
+  const nlohmann::json baseline = {{"format_version", format_version},
+                                   {"case", p.name},
+                                   {"case_file", p.file.lexically_normal().string()},
+                                   {"case_file_hash", file_hash(p.file)},
+                                   {"mesh_hash", surface_hash(run.problem.surface)},
+                                   {"units", {{"length", "m"}}},
+                                   {"degree", p.fem.degree},
+                                   {"git_revision", git_revision()},
+                                   {"date", date},
+                                   {"fields_file", fields_file},
+                                   {"variants", variants}};
+  std::filesystem::create_directories(directory);
+  FemField fem{run.mesh.vertices, run.mesh.tetrahedra, run.fem.vertex_displacement};
+  write_fields_h5(directory / fields_file, run.problem.surface.vertices,
+                  run.problem.surface.triangles, fem, fields);
+  write_text_atomically(directory / (p.name + ".json"), baseline.dump(1) + "\n");
+  return baseline;
 }
 
-std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohmann::json& base) {
+std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohmann::json& base,
+                                                 const std::filesystem::path& directory) {
   const auto& p = run.problem.parameters;
   std::vector<RegressionRow> rows;
   auto header = [&](const std::string& what, const std::string& b, const std::string& now) {
@@ -197,7 +203,7 @@ std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohm
     }
     for (const auto& m : regression_metrics())
       compare_metric(p.name, v, m, variants.at(v.name).at("metrics"), rows);
-    compare_field(p.name, v, variants.at(v.name), rows);
+    compare_field(p.name, v, variants.at(v.name), directory / base.value("fields_file", ""), rows);
   }
   for (const auto& [name, unused] : variants.items()) {
     bool ran = false;

@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "msfem/compare/result_writers.hpp"
 
 namespace msfem {
 namespace {
@@ -39,7 +41,7 @@ TEST_F(Regress, UnchangedModelPassesAndPrintsTheTable) {
   EXPECT_NE(r.out.find("surface_displacement"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(read_text(baseline_file()));
   for (const char* key : {"format_version", "case_file_hash", "mesh_hash", "units", "degree",
-                          "git_revision", "date", "variants"})
+                          "git_revision", "date", "fields_file", "variants"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 
@@ -83,12 +85,28 @@ TEST_F(Regress, EditedCaseIsAStaleBaseline) {
 }
 
 TEST_F(Regress, NonFiniteValueInTheBaselineFieldFails) {
-  auto j = nlohmann::json::parse(read_text(baseline_file()));
-  j["variants"]["tet_edges"]["field"]["data"][7] = nullptr;  // what a NaN becomes in JSON
-  std::ofstream(baseline_file()) << j.dump();
+  // Overwrite one stored displacement in the baseline's HDF5 file with a NaN: the datasets are
+  // contiguous little-endian doubles, so the row's 24 bytes are found in the file as they are.
+  const auto fields = tmp_ / "baselines" / "small_sphere.fields.h5";
+  const Eigen::MatrixXd u = compare::read_h5_matrix(fields, "/variants/tet_edges/displacement");
+  const double row[3] = {u(7, 0), u(7, 1), u(7, 2)};
+  std::string bytes = read_text(fields);
+  const auto at = bytes.find(std::string(reinterpret_cast<const char*>(row), sizeof row));
+  ASSERT_NE(at, std::string::npos);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  bytes.replace(at, sizeof nan, reinterpret_cast<const char*>(&nan), sizeof nan);
+  std::ofstream(fields, std::ios::binary) << bytes;
+  ASSERT_FALSE(compare::read_h5_matrix(fields, "/variants/tet_edges/displacement").allFinite());
   const auto r = regress();
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_NE(r.out.find("NON-FINITE"), std::string::npos) << r.out;
+}
+
+TEST_F(Regress, MissingFieldsFileFails) {
+  std::filesystem::remove(tmp_ / "baselines" / "small_sphere.fields.h5");
+  const auto r = regress();
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("MISSING"), std::string::npos) << r.out;
 }
 
 TEST_F(Regress, VariantWithoutReferenceFails) {

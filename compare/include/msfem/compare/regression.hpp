@@ -16,9 +16,12 @@ namespace msfem::compare {
 /// The metrics compared, each "worse" when it grows (volume_change: when its magnitude grows).
 const std::vector<std::string>& regression_metrics();
 
-/// A baseline made from a run: header (format version, case and mesh hashes, units, degree, git
-/// revision, date), per variant the metrics with default tolerances and the surface field.
-nlohmann::json make_baseline(const CaseRun& run);
+/// Writes a run's baseline into `directory`: `<case>.json` (header: format version, case and mesh
+/// hashes, units, degree, git revision, date; per variant the metrics and the field's tolerances)
+/// and
+/// `<case>.fields.h5` (the run's fields.h5 layout: surface, FEM volume field, per-variant surface
+/// displacement and error). Returns the JSON written.
+nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& directory);
 
 /// 16 hex digits of the FNV-1a hash of a file's bytes / of the surface arrays.
 std::string file_hash(const std::filesystem::path& file);
@@ -32,9 +35,9 @@ struct RegressionRow {
 };
 
 /// Compares a run with its baseline; rows for every metric and the field of every variant, plus
-/// rows for what is missing on either side or stale.
-std::vector<RegressionRow> compare_with_baseline(const CaseRun& run,
-                                                 const nlohmann::json& baseline);
+/// rows for what is missing on either side or stale. `directory` holds the baseline's fields file.
+std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohmann::json& baseline,
+                                                 const std::filesystem::path& directory);
 
 std::string regression_table(const std::vector<RegressionRow>& rows);
 
