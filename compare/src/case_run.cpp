@@ -135,9 +135,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     r.tool_force = s.tool_force;
     if (tool)
       r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
-    cases::Surface deformed = problem.surface;
-    deformed.vertices += s.surface_displacement;
-    r.volume_change = cases::signed_volume(deformed) / cases::signed_volume(problem.surface) - 1.0;
+    r.volume_change = volume_change(problem.surface, s.surface_displacement);
     if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
     for (double depth : depths) {
       if (depth == tool->depth) {

@@ -6,33 +6,13 @@
 #include <nlohmann/json.hpp>
 
 #include "msfem/compare/atomic_file.hpp"
+#include "msfem/compare/content_hash.hpp"
 
 namespace msfem::compare {
 namespace {
 
 // Bump when the FEM's formulation or the entry layout changes: old entries then miss.
 constexpr const char* cache_version = "msfem-fem-cache-3";
-
-class Fnv1a {
- public:
-  void bytes(const void* data, std::size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i)
-      hash_ = (hash_ ^ p[i]) * 1099511628211ull;
-  }
-  void text(const std::string& s) { bytes(s.data(), s.size() + 1); }
-  void number(double x) { bytes(&x, sizeof x); }
-  template <typename Derived>
-  void matrix(const Eigen::DenseBase<Derived>& m) {
-    for (Eigen::Index i = 0; i < m.rows(); ++i)
-      for (Eigen::Index j = 0; j < m.cols(); ++j)
-        number(static_cast<double>(m(i, j)));
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 14695981039346656037ull;
-};
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
   return {{"rows", m.rows()},
@@ -58,7 +38,7 @@ Eigen::Vector3d vec_from(const nlohmann::json& j) {
 
 std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths) {
   const auto& p = problem.parameters;
-  Fnv1a h;
+  ContentHash h;
   h.text(cache_version);
   h.matrix(problem.surface.vertices);
   h.matrix(problem.surface.triangles);
@@ -89,9 +69,7 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
   h.number(p.fem.relative_tolerance);
   for (double d : curve_depths)
     h.number(d);
-  char key[17];
-  std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(h.value()));
-  return key;
+  return h.hex();
 }
 
 std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directory,

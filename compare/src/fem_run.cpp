@@ -47,8 +47,7 @@ std::vector<bool> prescribed_surface_vertices(const Problem& problem,
 }
 
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                      const std::optional<ToolPlacement>& tool,
-                      const std::optional<std::filesystem::path>& output_directory) {
+                      const std::optional<ToolPlacement>& tool) {
   const auto& p = problem.parameters;
   fem_reference::ElasticityModel model;
   model.degree = static_cast<unsigned>(p.fem.degree);
@@ -67,9 +66,7 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
 
   const auto& patch = p.loads.patch_force;
   if (patch.enabled) {
-    Eigen::Index center = 0;
-    ((problem.surface.vertices.rowwise() - problem.centroid.transpose()) * patch.direction)
-        .maxCoeff(&center);
+    const int center = farthest_vertex(problem.surface, problem.centroid, patch.direction);
     const Eigen::Vector3d c = problem.surface.vertices.row(center).transpose();
     // Spread the total force as a uniform traction over the patch's area on the surface.
     double patch_area = 0;
@@ -98,11 +95,7 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
       solution.vertex_displacement.topRows(problem.surface.num_vertices());
   if (tool) solution.tool_force = -fem.reaction_force("tool");
   solution.statistics = fem.statistics();
-  cases::Surface deformed = problem.surface;
-  deformed.vertices += solution.surface_displacement;
-  solution.volume_change =
-      cases::signed_volume(deformed) / cases::signed_volume(problem.surface) - 1.0;
-  if (output_directory) fem.output_results(*output_directory, "fem");
+  solution.volume_change = volume_change(problem.surface, solution.surface_displacement);
   return solution;
 }
 

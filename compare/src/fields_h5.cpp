@@ -2,18 +2,8 @@
 // and for `msfem regress`. The HDF5 library is deal.II's OpenMPI build (one HDF5 per process), used
 // serially: default property lists, no MPI-IO driver.
 
-// That build's hdf5.h includes <mpi.h>. Where this file is compiled without an MPI include path,
-// the serial build's headers of the same release stand in: Debian builds both from one source, and
-// their C headers are identical except H5pubconf.h, which differs only in the parallel and thread
-// switches (declarations of the MPI-IO functions, unused here). require_matching_release() checks
-// at run time that the headers and the linked library are one release.
-#if __has_include(<mpi.h>)
+// OpenMPI's hdf5.h includes <mpi.h>: compare/CMakeLists.txt puts MPI on the include path.
 #include <hdf5.h>
-#elif __has_include(<hdf5/serial/hdf5.h>)
-#include <hdf5/serial/hdf5.h>
-#else
-#error "fields_h5.cpp: <hdf5.h> of OpenMPI's HDF5 needs <mpi.h> on the include path"
-#endif
 
 #include <cstdint>
 #include <set>
@@ -60,17 +50,6 @@ std::string hdf5_error_message() {
       },
       &message);
   return message;
-}
-
-void require_matching_release() {
-  unsigned major = 0, minor = 0, release = 0;
-  if (H5get_libversion(&major, &minor, &release) < 0 || major != H5_VERS_MAJOR ||
-      minor != H5_VERS_MINOR || release != H5_VERS_RELEASE)
-    throw std::runtime_error("the HDF5 library (" + std::to_string(major) + "." +
-                             std::to_string(minor) + "." + std::to_string(release) +
-                             ") is not the release msfem was compiled against (" +
-                             std::to_string(H5_VERS_MAJOR) + "." + std::to_string(H5_VERS_MINOR) +
-                             "." + std::to_string(H5_VERS_RELEASE) + ")");
 }
 
 [[noreturn]] void fail(const fs::path& file, const std::string& object, const std::string& what) {
@@ -228,7 +207,6 @@ void write_fields_h5(const fs::path& path, const Eigen::MatrixX3d& surface_verti
                      const Eigen::MatrixX3i& surface_triangles, const FemField& fem,
                      const std::vector<VariantField>& variants) {
   check_fields(surface_vertices, surface_triangles, fem, variants);
-  require_matching_release();
   write_file_atomically(path, [&](const fs::path& temporary) {
     SilenceHdf5Errors silence;
     Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
@@ -242,7 +220,6 @@ void write_fields_h5(const fs::path& path, const Eigen::MatrixX3d& surface_verti
 namespace {
 
 Handle open_for_reading(const fs::path& path) {
-  require_matching_release();
   if (!fs::is_regular_file(path))
     throw std::runtime_error("HDF5 file '" + path.string() + "' does not exist");
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);

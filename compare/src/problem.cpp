@@ -62,10 +62,9 @@ std::function<bool(const Eigen::Vector3d&)> fixed_region(const cases::CaseParame
 ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s,
                          const Eigen::MatrixX3d& normals, const Eigen::Vector3d& centroid,
                          const Eigen::Vector3d& direction) {
-  Eigen::Index best = 0;
-  ((s.vertices.rowwise() - centroid.transpose()) * direction).maxCoeff(&best);
+  const int best = farthest_vertex(s, centroid, direction);
   ToolPlacement t;
-  t.vertex = static_cast<int>(best);
+  t.vertex = best;
   t.contact_point = s.vertices.row(best).transpose();
   t.outward_normal = normals.row(best).transpose();
   t.radius = p.loads.tool.radius_m;
@@ -96,6 +95,19 @@ fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
     return t * inward;
   };
   return support;
+}
+
+int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
+                    const Eigen::Vector3d& direction) {
+  Eigen::Index best = 0;
+  ((surface.vertices.rowwise() - centroid.transpose()) * direction).maxCoeff(&best);
+  return static_cast<int>(best);
+}
+
+double volume_change(const cases::Surface& surface, const Eigen::MatrixX3d& displacement) {
+  cases::Surface deformed = surface;
+  deformed.vertices += displacement;
+  return cases::signed_volume(deformed) / cases::signed_volume(surface) - 1.0;
 }
 
 ToolPlacement at_depth(ToolPlacement tool, double depth) {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "msfem/compare/atomic_file.hpp"
+#include "msfem/compare/content_hash.hpp"
 #include "msfem/compare/result_writers.hpp"
 #include "msfem/compare/run_outputs.hpp"
 
@@ -18,19 +19,6 @@ constexpr int format_version = 2;
 // Default tolerances written into a new baseline (numdiff style: |now − base| <= abs + rel |base|).
 constexpr double metric_abs_tol = 1e-9, metric_rel_tol = 1e-3;
 constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the largest |u|
-
-std::string hex(std::uint64_t h) {
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
-  return text;
-}
-
-std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 14695981039346656037ull) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < n; ++i)
-    h = (h ^ p[i]) * 1099511628211ull;
-  return h;
-}
 
 double metric_value(const VariantResult& v, const std::string& metric) {
   if (metric == "rel_l2_error") return v.errors.all.rel_l2_error;
@@ -126,14 +114,14 @@ const std::vector<std::string>& regression_metrics() {
 std::string file_hash(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return hex(fnv1a(bytes.data(), bytes.size()));
+  return ContentHash().bytes(bytes.data(), bytes.size()).hex();
 }
 
 std::string surface_hash(const cases::Surface& s) {
-  std::uint64_t h =
-      fnv1a(s.vertices.data(), sizeof(double) * static_cast<std::size_t>(s.vertices.size()));
-  h = fnv1a(s.triangles.data(), sizeof(int) * static_cast<std::size_t>(s.triangles.size()), h);
-  return hex(h);
+  return ContentHash()
+      .bytes(s.vertices.data(), sizeof(double) * static_cast<std::size_t>(s.vertices.size()))
+      .bytes(s.triangles.data(), sizeof(int) * static_cast<std::size_t>(s.triangles.size()))
+      .hex();
 }
 
 nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& directory) {

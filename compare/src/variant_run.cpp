@@ -90,8 +90,7 @@ void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
   const auto& patch = problem.parameters.loads.patch_force;
   if (!patch.enabled) return;
   const auto& s = problem.surface;
-  Eigen::Index center = 0;
-  ((s.vertices.rowwise() - problem.centroid.transpose()) * patch.direction).maxCoeff(&center);
+  const int center = farthest_vertex(s, problem.centroid, patch.direction);
   const Eigen::VectorXd areas = ms::vertex_areas(s.vertices, s.triangles);
   std::vector<int> nodes;
   double total_area = 0;

@@ -6,12 +6,12 @@
 
 #include <map>
 #include <memory>
-#include <random>
 
 #include "msfem/massspring/benchmark_cases.hpp"
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/stability.hpp"
+#include "msfem/massspring/stepping_benchmark.hpp"
 #include "obj_surface.hpp"
 
 namespace {
@@ -34,19 +34,6 @@ const MassSpringModel& model_for(const std::string& name) {
     }
   }
   return *models.at(name);
-}
-
-// Rest state with every node moved by a fixed pseudo-random 10⁻³ of the mean spring length, as in
-// run_stepping_benchmark: all springs loaded, the motion bounded.
-State perturbed_start(const MassSpringModel& model) {
-  State start = initial_state(model);
-  std::mt19937 generator(2007);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const double amplitude = 1e-3 * model.network().rest_length.mean();
-  for (Eigen::Index k = 0; k < start.x.size(); ++k)
-    start.x[k] += amplitude * uniform(generator);
-  model.enforce_constraints(start.x, start.v);
-  return start;
 }
 
 void annotate(benchmark::State& state, const MassSpringModel& model, int steps_per_iteration) {

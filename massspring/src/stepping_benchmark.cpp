@@ -111,6 +111,17 @@ double median_rate(Advance advance, int steps_per_call, const SteppingBenchmarkO
 
 }  // namespace
 
+State perturbed_start(const MassSpringModel& model) {
+  State start = initial_state(model);
+  std::mt19937 generator(2007);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const double amplitude = 1e-3 * model.network().rest_length.mean();
+  for (Eigen::Index k = 0; k < start.x.size(); ++k)
+    start.x[k] += amplitude * uniform(generator);
+  model.enforce_constraints(start.x, start.v);
+  return start;
+}
+
 SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
                                                const SteppingBenchmarkOptions& options) {
   SteppingBenchmarkResult result;
@@ -119,15 +130,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
   result.explicit_dt =
       0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
 
-  State start = initial_state(model);
-  {
-    std::mt19937 generator(2007);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    const double amplitude = 1e-3 * model.network().rest_length.mean();
-    for (Eigen::Index k = 0; k < start.x.size(); ++k)
-      start.x[k] += amplitude * uniform(generator);
-    model.enforce_constraints(start.x, start.v);
-  }
+  const State start = perturbed_start(model);
 
   FastStepperOptions fast_options;
   fast_options.threads = options.threads;

@@ -2,7 +2,6 @@
 // The FEM reference on a problem: one volume mesh, one solve per tool placement (or per load).
 
 #include <Eigen/Core>
-#include <filesystem>
 #include <optional>
 
 #include "msfem/compare/problem.hpp"
@@ -23,11 +22,9 @@ struct FemSolution {
   fem_reference::SolveStatistics statistics;
 };
 
-/// Solves the problem's FEM for `tool` (none: gravity and patch force only). Writes the FEM's VTU
-/// into `output_directory` (as fem.pvd) when given.
+/// Solves the problem's FEM for `tool` (none: gravity and patch force only).
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                      const std::optional<ToolPlacement>& tool,
-                      const std::optional<std::filesystem::path>& output_directory = std::nullopt);
+                      const std::optional<ToolPlacement>& tool);
 
 /// Surface vertices that a support or the tool prescribes (excluded from the error metrics).
 std::vector<bool> prescribed_surface_vertices(const Problem& problem,

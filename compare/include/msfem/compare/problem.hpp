@@ -41,6 +41,14 @@ struct Problem {
 /// fixed region or tool that catches no surface node, or a tool deeper than the model.
 Problem make_problem(const cases::CaseParameters& parameters);
 
+/// The surface vertex farthest from `centroid` along `direction`: where a tool presses or a patch
+/// force pulls.
+int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
+                    const Eigen::Vector3d& direction);
+
+/// Enclosed volume of the surface moved by `displacement` (per vertex) over its rest volume, − 1.
+double volume_change(const cases::Surface& surface, const Eigen::MatrixX3d& displacement);
+
 /// The tool at a given depth (the force-depth curve uses several).
 ToolPlacement at_depth(ToolPlacement tool, double depth);
 

@@ -60,6 +60,10 @@ struct SteppingBenchmarkResult {
 /// stepper on the model (loads and supports as set in it), in this process, after a warm-up. All
 /// three start from the rest state with every free node displaced by a fixed pseudo-random 10⁻³ of
 /// the mean spring length, so that every spring is loaded and the run stays bounded.
+/// Rest state with every node moved by a fixed pseudo-random 10⁻³ of the mean spring length: all
+/// springs loaded, the motion bounded. Every speed measurement starts from it.
+State perturbed_start(const MassSpringModel& model);
+
 SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
                                                const SteppingBenchmarkOptions& options = {});
 
