@@ -10,6 +10,7 @@ packages=(
   libcgal-dev            # surface validation (self-intersections) and simplification
   libhdf5-openmpi-dev    # fields.h5 output (the HDF5 deal.II links, so one HDF5 per process)
   nlohmann-json3-dev     # summary.json and every --json output
+  libnlopt-cxx-dev       # msfem calibrate: derivative-free optimiser (BOBYQA) for spring coefficients
   libgtest-dev           # unit and end-to-end tests
   libbenchmark-dev       # speed measurements
   gnuplot-nox            # plots in report.md

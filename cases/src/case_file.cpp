@@ -6,6 +6,7 @@
 #include <deal.II/base/patterns.h>
 #include <deal.II/base/utilities.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <regex>
@@ -154,6 +155,31 @@ void declare_fem_timing_output(ParameterHandler& prm) {
   prm.leave_subsection();
 }
 
+void declare_calibration(ParameterHandler& prm) {
+  prm.enter_subsection("calibration");
+  prm.declare_entry("variant", "", Patterns::Anything(),
+                    "Variant msfem calibrate fits when --variant is not given (empty: the first "
+                    "of mass spring/variants).");
+  prm.declare_entry("fit groups", "", Patterns::List(Patterns::Anything()),
+                    "Spring groups whose stiffness is fitted (empty: every group of the variant).");
+  prm.declare_entry("train loads", "", Patterns::Anything(),
+                    "Training tool loads, DX,DY,DZ@DEPTH separated by ';' (depth in m).");
+  prm.declare_entry("test loads", "", Patterns::Anything(),
+                    "Held-out tool loads (other positions or depths than the training ones).");
+  prm.declare_entry("force weight", "1", Patterns::Double(0),
+                    "Objective: mean over training loads of rel_l2_error^2 + w "
+                    "reaction_force_rel_error^2.");
+  prm.declare_entry("max evaluations", "400", Patterns::Integer(1, 1000000),
+                    "Objective evaluations allowed (each is one static solve per training load).");
+  prm.declare_entry("tolerance", "1e-5", Patterns::Double(0, 1),
+                    "Converged when the log-coefficients move by less than this.");
+  prm.declare_entry("bound factor", "100", Patterns::Double(1.0),
+                    "Each fitted factor stays within [1/b, b] of its starting value.");
+  prm.declare_entry("target damping ratio", "0.5", Patterns::Double(0),
+                    "Damping ratio of the slowest mode that the damping fit aims for.");
+  prm.leave_subsection();
+}
+
 void declare_all(ParameterHandler& prm) {
   declare_geometry(prm);
   declare_material(prm);
@@ -161,6 +187,7 @@ void declare_all(ParameterHandler& prm) {
   declare_loads(prm);
   declare_mass_spring(prm);
   declare_fem_timing_output(prm);
+  declare_calibration(prm);
 }
 
 // deal.II's messages span several indented lines and write "Line <12> of file <a.prm>"; users and
@@ -315,16 +342,30 @@ CaseParameters extract(ParameterHandler& prm) {
   prm.enter_subsection("output");
   c.output.directory = prm.get("directory");
   prm.leave_subsection();
+  prm.enter_subsection("calibration");
+  auto& cal = c.calibration;
+  cal.variant = prm.get("variant");
+  cal.groups = dealii::Utilities::split_string_list(prm.get("fit groups"));
+  cal.train = parse_tool_loads(prm.get("train loads"), "calibration/train loads");
+  cal.test = parse_tool_loads(prm.get("test loads"), "calibration/test loads");
+  cal.force_weight = prm.get_double("force weight");
+  cal.max_evaluations = static_cast<int>(prm.get_integer("max evaluations"));
+  cal.tolerance = prm.get_double("tolerance");
+  cal.bound_factor = prm.get_double("bound factor");
+  cal.target_damping_ratio = prm.get_double("target damping ratio");
+  prm.leave_subsection();
+  if (!cal.variant.empty() &&
+      std::find(ms.variants.begin(), ms.variants.end(), cal.variant) == ms.variants.end())
+    throw InputError("calibration/variant: '" + cal.variant +
+                     "' is not one of mass spring/variants");
   return c;
 }
 
-}  // namespace
-
-CaseParameters read_case(const std::filesystem::path& file,
-                         const std::vector<std::string>& overrides) {
+// Declares the language, parses the file and applies the overrides.
+void load_case(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+               ParameterHandler& prm) {
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot open case file");
-  ParameterHandler prm;
   declare_all(prm);
   try {
     prm.parse_input(in, file.string(), "", /*skip_undefined=*/false);
@@ -333,6 +374,46 @@ CaseParameters read_case(const std::filesystem::path& file,
   }
   for (const auto& o : overrides)
     apply_override(prm, o);
+}
+
+}  // namespace
+
+std::string ToolLoad::label() const {
+  std::ostringstream out;
+  out << direction.x() << ',' << direction.y() << ',' << direction.z() << '@' << depth_m;
+  return out.str();
+}
+
+bool ToolLoad::same_as(const ToolLoad& other) const {
+  return (direction - other.direction).norm() < 1e-9 && std::abs(depth_m - other.depth_m) < 1e-12;
+}
+
+std::vector<ToolLoad> parse_tool_loads(const std::string& text, const std::string& key) {
+  std::vector<ToolLoad> loads;
+  for (const auto& entry : dealii::Utilities::split_string_list(text, ';')) {
+    const auto at = entry.find('@');
+    ToolLoad load;
+    try {
+      if (at == std::string::npos) throw InputError("no '@'");
+      load.direction = unit_vector(entry.substr(0, at), key);
+      std::size_t used = 0;
+      const std::string depth = dealii::Utilities::trim(entry.substr(at + 1));
+      load.depth_m = std::stod(depth, &used);
+      if (used != depth.size() || !(load.depth_m > 0) || !std::isfinite(load.depth_m))
+        throw InputError("bad depth");
+    } catch (const std::exception&) {
+      throw InputError(key + ": '" + entry +
+                       "' is not DX,DY,DZ@DEPTH with a non-zero direction and a depth > 0 (m)");
+    }
+    loads.push_back(load);
+  }
+  return loads;
+}
+
+CaseParameters read_case(const std::filesystem::path& file,
+                         const std::vector<std::string>& overrides) {
+  ParameterHandler prm;
+  load_case(file, overrides, prm);
   CaseParameters c;
   try {
     c = extract(prm);
@@ -347,6 +428,16 @@ CaseParameters read_case(const std::filesystem::path& file,
     if (p.is_relative()) c.geometry.source = (file.parent_path() / p).lexically_normal().string();
   }
   return c;
+}
+
+std::string case_file_text(const std::filesystem::path& file,
+                           const std::vector<std::string>& overrides) {
+  ParameterHandler prm;
+  load_case(file, overrides, prm);
+  std::ostringstream out;
+  prm.print_parameters(out, ParameterHandler::OutputStyle::ShortPRM |
+                                ParameterHandler::OutputStyle::KeepDeclarationOrder);
+  return out.str();
 }
 
 std::string describe_case_parameters() {

@@ -19,16 +19,16 @@ double mean_edge_length(const cases::Surface& s) {
 
 }  // namespace
 
-fem_reference::VolumeMesh mesh_problem(const Problem& problem) {
+fem_reference::VolumeMesh mesh_problem(const Problem& problem,
+                                       std::optional<std::vector<ToolPlacement>> refine_near) {
   const auto& p = problem.parameters;
   fem_reference::MeshOptions options;
   const double edge = mean_edge_length(problem.surface);
   options.cell_size = p.fem.cell_size_m > 0 ? p.fem.cell_size_m : edge;
-  if (!problem.tools.empty()) {
-    const ToolPlacement& t = problem.tools.front();
-    options.refinement = fem_reference::LocalRefinement{t.contact_point, 2 * t.radius, 2 * t.radius,
-                                                        0.5 * options.cell_size};
-  }
+  if (!refine_near && !problem.tools.empty()) refine_near = {problem.tools.front()};
+  for (const ToolPlacement& t : refine_near.value_or(std::vector<ToolPlacement>{}))
+    options.refinements.push_back(fem_reference::LocalRefinement{
+        t.contact_point, 2 * t.radius, 2 * t.radius, 0.5 * options.cell_size});
   return fem_reference::mesh_closed_surface(problem.surface.vertices, problem.surface.triangles,
                                             options);
 }

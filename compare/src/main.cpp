@@ -31,6 +31,13 @@ const std::vector<CommandEntry>& commands() {
        "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]...\n"
        "      compare runs with committed baselines; exit 1 on a worse metric or field, a missing\n"
        "      or stale baseline, or a non-finite value"},
+      {"calibrate", calibrate_command,
+       "calibrate CASE.prm [--variant NAME] [--fit GROUP[,GROUP...]] [--train LOADS] [--test "
+       "LOADS]\n"
+       "          [--out DIR] [--set K=V]... [--max-evaluations N] [--strict] [--json] "
+       "[--no-compare]\n"
+       "      fit spring-group stiffness to the FEM on training loads (DX,DY,DZ@DEPTH;...), check\n"
+       "      on held-out loads; calibration.json, report.md, calibrated.prm"},
       {"params", params_command, "params\n      print the whole case-file language"},
       {"mesh-info", mesh_info_command,
        "mesh-info FILE [--unit m|cm|mm] [--json] [--no-self-intersections]\n"

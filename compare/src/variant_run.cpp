@@ -165,15 +165,15 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
   return variant;
 }
 
-StaticSolution solve_variant_static(const BuiltVariant& variant) {
+StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::VectorXd& start) {
   const ms::MassSpringModel& model = *variant.model;
-  const auto start = Clock::now();
+  const auto clock_start = Clock::now();
   ms::StaticOptions options;
   // A sparse factorisation's fill-in grows quickly with the brain-scale networks; CG does not.
   if (model.num_nodes() > 500000) options.linear_solver = ms::StaticLinearSolver::cg;
-  const ms::StaticResult r = ms::solve_static(model, options);
+  const ms::StaticResult r = ms::solve_static(model, options, start);
   StaticSolution solution;
-  solution.solve_time_s = seconds_since(start);
+  solution.solve_time_s = seconds_since(clock_start);
   if (!r.converged)
     throw std::runtime_error("variant " + variant.name + ": Newton did not converge in " +
                              std::to_string(r.iterations) + " iterations (residual " +

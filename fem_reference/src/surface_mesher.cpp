@@ -32,14 +32,19 @@ double mean_edge_length(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i
   return sum / double(3 * triangles.rows());
 }
 
-/// The size field: the global size, smaller in the refinement ball with a linear transition.
+/// The size field: the global size, smaller in each refinement ball with a linear transition.
 double target_size(const MeshOptions& options, double global_size, const Eigen::Vector3d& x) {
-  if (!options.refinement) return global_size;
-  const LocalRefinement& r = *options.refinement;
-  const double outside = std::max(0.0, (x - r.center).norm() - r.radius);
-  if (r.transition <= 0.0) return outside > 0.0 ? global_size : r.cell_size;
-  const double w = std::min(1.0, outside / r.transition);
-  return std::min(global_size, (1.0 - w) * r.cell_size + w * global_size);
+  double size = global_size;
+  for (const LocalRefinement& r : options.refinements) {
+    const double outside = std::max(0.0, (x - r.center).norm() - r.radius);
+    if (r.transition <= 0.0) {
+      if (outside <= 0.0) size = std::min(size, r.cell_size);
+      continue;
+    }
+    const double w = std::min(1.0, outside / r.transition);
+    size = std::min(size, (1.0 - w) * r.cell_size + w * global_size);
+  }
+  return size;
 }
 
 }  // namespace

@@ -16,7 +16,7 @@ namespace {
 TEST(PointLocator, FindsTheContainingCellOfRandomPoints) {
   const testing::TestSurface surface = testing::icosphere(2, 1.0);
   const VolumeMesh mesh =
-      mesh_closed_surface(surface.vertices, surface.triangles, MeshOptions{0.15, std::nullopt, 1});
+      mesh_closed_surface(surface.vertices, surface.triangles, MeshOptions{0.15, {}, 1});
   const PointLocator locator(mesh);
   std::mt19937 random(42);
   std::uniform_real_distribution<double> coordinate(-0.9, 0.9);
@@ -69,7 +69,7 @@ TEST(PointLocator, EvaluatesAQuadraticFieldInP2AtArbitraryPoints) {
       -c * Eigen::Vector3d(3 * (lambda + mu) + 2 * mu, 0.0, 2 * (lambda + mu) + 2 * mu);
   const testing::TestSurface surface = testing::icosphere(2, 1.0);
   const VolumeMesh mesh =
-      mesh_closed_surface(surface.vertices, surface.triangles, MeshOptions{0.2, std::nullopt, 1});
+      mesh_closed_surface(surface.vertices, surface.triangles, MeshOptions{0.2, {}, 1});
   ElasticityModel model;
   model.degree = 2;
   model.material.youngs_modulus = E;

@@ -50,7 +50,7 @@ TEST(SurfaceMesher, RefinesNearTheTool) {
   MeshOptions options;
   options.cell_size = 0.01;
   const VolumeMesh coarse = mesh_closed_surface(sphere.vertices, sphere.triangles, options);
-  options.refinement = LocalRefinement{Eigen::Vector3d(0, 0, 0.04), 0.01, 0.01, 0.003};
+  options.refinements = {LocalRefinement{Eigen::Vector3d(0, 0, 0.04), 0.01, 0.01, 0.003}};
   const VolumeMesh refined = mesh_closed_surface(sphere.vertices, sphere.triangles, options);
   auto count_near = [](const VolumeMesh& m) {
     int n = 0;

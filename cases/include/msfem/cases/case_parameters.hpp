@@ -99,6 +99,32 @@ struct TimingParameters {
   int steps = 2000;   ///< dynamic steps timed for steps/s
 };
 
+/// A tool load of a calibration: the case's tool pressed `depth_m` deep where `direction` points
+/// (written DX,DY,DZ@DEPTH in case files and on the command line).
+struct ToolLoad {
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< unit
+  double depth_m = 0.0;
+  /// "DX,DY,DZ@DEPTH" with the direction as given (normalised) and the depth in metres.
+  std::string label() const;
+  /// Same direction (to 1e-9) and depth (to 1e-12 m).
+  bool same_as(const ToolLoad& other) const;
+};
+
+/// Defaults of `msfem calibrate` (each has a command-line option that overrides it).
+struct CalibrationParameters {
+  std::string variant;              ///< empty: the first of mass spring/variants
+  std::vector<std::string> groups;  ///< spring groups to fit (empty: all of the variant's)
+  std::vector<ToolLoad> train, test;
+  double force_weight = 1.0;          ///< J = mean over loads of e_disp² + w e_force²
+  int max_evaluations = 400;          ///< objective evaluations (each: one static solve per load)
+  double tolerance = 1e-5;            ///< stop when a step changes every log coefficient by less
+  double bound_factor = 100.0;        ///< each factor stays within [1/b, b] of its start
+  double target_damping_ratio = 0.5;  ///< of the slowest mode, for the damping fit
+};
+
+/// Parses "DX,DY,DZ@DEPTH; ..." (depth in metres); throws InputError naming `key` and the entry.
+std::vector<ToolLoad> parse_tool_loads(const std::string& text, const std::string& key);
+
 struct OutputParameters {
   std::string directory = "results/runs";
 };
@@ -114,6 +140,7 @@ struct CaseParameters {
   FemParameters fem;
   TimingParameters timing;
   OutputParameters output;
+  CalibrationParameters calibration;
 };
 
 /// Reads a case file, then applies `overrides` ("section/key=value", or "section/sub/key=value").
@@ -121,6 +148,11 @@ struct CaseParameters {
 /// a bad override throws InputError with one line naming the file and line (or the override).
 CaseParameters read_case(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides = {});
+
+/// The case file with `overrides` applied, printed back as a complete parameter file (every key,
+/// in declaration order): how `msfem calibrate` writes calibrated.prm. Throws like read_case().
+std::string case_file_text(const std::filesystem::path& file,
+                           const std::vector<std::string>& overrides = {});
 
 /// The whole input language (every section, key, default, pattern and documentation).
 std::string describe_case_parameters();

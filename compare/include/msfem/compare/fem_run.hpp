@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 #include "msfem/compare/problem.hpp"
 #include "msfem/fem_reference/elasticity_problem.hpp"
@@ -11,8 +12,9 @@
 namespace msfem::compare {
 
 /// The tetrahedral mesh of the problem's surface (its vertices kept as mesh vertices 0..n-1), sized
-/// by fem/cell size and refined near the first tool.
-fem_reference::VolumeMesh mesh_problem(const Problem& problem);
+/// by fem/cell size and refined near the given tools (none given: near the first of the problem's).
+fem_reference::VolumeMesh mesh_problem(
+    const Problem& problem, std::optional<std::vector<ToolPlacement>> refine_near = std::nullopt);
 
 struct FemSolution {
   Eigen::MatrixX3d surface_displacement;                 ///< n_surface x 3, m

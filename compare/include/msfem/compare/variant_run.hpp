@@ -41,7 +41,10 @@ struct StaticSolution {
   int newton_iterations = 0;
   double solve_time_s = 0.0;
 };
-StaticSolution solve_variant_static(const BuiltVariant& variant);
+/// Newton from `start` when it has the model's size (a nearby equilibrium: few iterations), else
+/// from rest.
+StaticSolution solve_variant_static(const BuiltVariant& variant,
+                                    const Eigen::VectorXd& start = Eigen::VectorXd());
 
 struct Timing {
   std::string integrator;

@@ -1,7 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <optional>
+#include <vector>
 
 #include "msfem/fem_reference/volume_mesh.hpp"
 
@@ -20,7 +20,8 @@ struct MeshOptions {
   /// Target edge length of the interior tetrahedra in metres; 0 means the mean edge length of the
   /// surface. Boundary triangles are never changed: their size is the surface's.
   double cell_size = 0.0;
-  std::optional<LocalRefinement> refinement;
+  /// Balls of smaller cells (the size field is the smallest any of them asks for).
+  std::vector<LocalRefinement> refinements;
   /// Gmsh's Mesh.Algorithm3D: 1 = Delaunay (default: the same mesh on every run), 10 = HXT
   /// (several times faster on large meshes, but Gmsh 4.8's HXT differs from run to run).
   int algorithm_3d = 1;

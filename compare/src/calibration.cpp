@@ -1,0 +1,318 @@
+#include "msfem/compare/calibration.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <nlopt.hpp>
+#include <stdexcept>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/compare/metrics.hpp"
+#include "msfem/massspring/errors.hpp"
+
+namespace msfem::compare {
+namespace {
+
+namespace ms = msfem::massspring;
+using Clock = std::chrono::steady_clock;
+
+// A value BOBYQA can work with when a static solve fails at a trial point (it cannot take inf):
+// far above any objective of a model that solves.
+constexpr double failed_objective = 1e6;
+
+std::string stop_reason(nlopt::result r) {
+  switch (r) {
+    case nlopt::SUCCESS:
+      return "success";
+    case nlopt::STOPVAL_REACHED:
+      return "objective reached the stop value";
+    case nlopt::FTOL_REACHED:
+      return "objective changed by less than its tolerance";
+    case nlopt::XTOL_REACHED:
+      return "coefficients moved by less than the tolerance";
+    case nlopt::MAXEVAL_REACHED:
+      return "evaluation limit reached before convergence";
+    case nlopt::MAXTIME_REACHED:
+      return "time limit reached before convergence";
+    default:
+      return "stopped (NLopt result " + std::to_string(static_cast<int>(r)) + ")";
+  }
+}
+
+bool is_converged(nlopt::result r) {
+  return r == nlopt::SUCCESS || r == nlopt::STOPVAL_REACHED || r == nlopt::FTOL_REACHED ||
+         r == nlopt::XTOL_REACHED;
+}
+
+double objective_of(const std::vector<LoadErrors>& errors, double force_weight) {
+  double sum = 0;
+  for (const auto& e : errors)
+    sum += e.rel_l2_error * e.rel_l2_error +
+           force_weight * e.reaction_force_rel_error * e.reaction_force_rel_error;
+  return sum / static_cast<double>(errors.size());
+}
+
+// One model per load (each with its own tool patch and warm start), sharing the stiffness.
+struct LoadModels {
+  std::vector<BuiltVariant> variants;
+  std::vector<Eigen::VectorXd> x;
+};
+
+LoadModels models_for(const BuiltVariant& base, const Problem& problem,
+                      const std::vector<LoadReference>& references) {
+  LoadModels m;
+  for (const auto& r : references) {
+    BuiltVariant v;
+    v.name = base.name;
+    v.model = std::make_unique<ms::MassSpringModel>(*base.model);
+    v.tool_patch = base.tool_patch;
+    set_tool_depth(v, problem, r.tool);
+    m.variants.push_back(std::move(v));
+    m.x.emplace_back();
+  }
+  return m;
+}
+
+std::vector<LoadErrors> evaluate_all(LoadModels& m, const Problem& problem,
+                                     const std::vector<LoadReference>& references,
+                                     const Eigen::VectorXd& stiffness) {
+  std::vector<LoadErrors> errors;
+  for (std::size_t i = 0; i < references.size(); ++i) {
+    m.variants[i].model->set_stiffness(stiffness);
+    m.x[i].resize(0);  // cold start: see the note in calibrate()
+    errors.push_back(evaluate_load(m.variants[i], problem, references[i], m.x[i]));
+  }
+  return errors;
+}
+
+// Free dofs of a model (constrained nodes removed) and its restricted matrices.
+struct FreeDofs {
+  std::vector<int> free_index, full_index;
+  explicit FreeDofs(const ms::MassSpringModel& model) : free_index(model.num_dofs(), -1) {
+    for (int i = 0; i < model.num_nodes(); ++i)
+      if (!model.is_constrained(i))
+        for (int c = 0; c < 3; ++c) {
+          free_index[3 * i + c] = static_cast<int>(full_index.size());
+          full_index.push_back(3 * i + c);
+        }
+  }
+  Eigen::SparseMatrix<double> restrict(const ms::Triplets& all) const {
+    ms::Triplets free;
+    for (const auto& t : all) {
+      const int r = free_index[t.row()], c = free_index[t.col()];
+      if (r >= 0 && c >= 0) free.emplace_back(r, c, -t.value());
+    }
+    const int n = static_cast<int>(full_index.size());
+    Eigen::SparseMatrix<double> a(n, n);
+    a.setFromTriplets(free.begin(), free.end());
+    return a;
+  }
+};
+
+}  // namespace
+
+LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
+                         const LoadReference& reference, Eigen::VectorXd& x) {
+  set_tool_depth(variant, problem, reference.tool);
+  const StaticSolution s = solve_variant_static(variant, x);
+  x = s.x;
+  LoadErrors e;
+  e.load = reference.load.label();
+  const ErrorMetrics m = displacement_error(s.surface_displacement, reference.surface_displacement,
+                                            reference.compared_vertices);
+  e.rel_l2_error = m.rel_l2_error;
+  e.mean_error_over_max_disp = m.mean_error_over_max_disp;
+  e.tool_force = s.tool_force;
+  e.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, reference.tool_force);
+  return e;
+}
+
+CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                         const std::string& variant_name, const std::vector<LoadReference>& train,
+                         const std::vector<LoadReference>& test,
+                         const CalibrationOptions& options) {
+  const auto start = Clock::now();
+  const std::string& file = problem.parameters.file.string();
+  if (train.empty())
+    throw cases::InputError(file +
+                            ": calibration: the training set is empty (give --train or "
+                            "calibration/train loads)");
+  const BuiltVariant base = build_variant(variant_name, problem, mesh, train.front().tool);
+  const auto& network = base.model->network();
+  std::vector<std::string> groups = options.groups;
+  if (groups.empty()) groups = network.spring_group_names;
+  std::string known;
+  for (const auto& g : network.spring_group_names)
+    known += (known.empty() ? "" : ", ") + g;
+  for (const auto& g : groups)
+    if (std::count(network.spring_group_names.begin(), network.spring_group_names.end(), g) != 1)
+      throw cases::InputError(file + ": calibration: variant " + variant_name +
+                              " has no spring group '" + g + "' (its groups: " + known + ")");
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    if (std::count(groups.begin(), groups.end(), groups[i]) > 1)
+      throw cases::InputError(file + ": calibration: group '" + groups[i] + "' is listed twice");
+  if (!options.start_factors.empty() && options.start_factors.size() != groups.size())
+    throw std::invalid_argument("calibrate: one start factor per fitted group is needed");
+
+  const int n = static_cast<int>(groups.size());
+  std::vector<int> group_id(n);
+  for (int g = 0; g < n; ++g)
+    group_id[g] = network.spring_group_id(groups[g]);
+  // The case's stiffness (analytic × its group scales) and the start (× the start factors).
+  const Eigen::VectorXd case_stiffness = network.stiffness;
+  Eigen::VectorXd start_stiffness = case_stiffness;
+  for (int g = 0; g < n; ++g)
+    for (int s = 0; s < network.num_springs(); ++s)
+      if (network.spring_group[s] == group_id[g] && !options.start_factors.empty())
+        start_stiffness[s] *= options.start_factors[g];
+  auto stiffness_at = [&](const std::vector<double>& theta) {
+    Eigen::VectorXd k = start_stiffness;
+    for (int s = 0; s < network.num_springs(); ++s)
+      for (int g = 0; g < n; ++g)
+        if (network.spring_group[s] == group_id[g]) k[s] *= std::exp(theta[g]);
+    return k;
+  };
+
+  LoadModels train_models = models_for(base, problem, train);
+  LoadModels test_models = models_for(base, problem, test);
+  CalibrationFit fit;
+  fit.before.train = evaluate_all(train_models, problem, train, start_stiffness);
+  fit.before.test = evaluate_all(test_models, problem, test, start_stiffness);
+  fit.objective_before = objective_of(fit.before.train, options.force_weight);
+
+  std::vector<double> best_theta(n, 0.0);
+  double best = fit.objective_before;
+  auto objective = [&](const std::vector<double>& theta) {
+    double j = failed_objective;
+    try {
+      j = objective_of(evaluate_all(train_models, problem, train, stiffness_at(theta)),
+                       options.force_weight);
+    } catch (const std::runtime_error&) {
+      // Newton failed at this trial point: steer the optimiser away from it.
+    }
+    fit.history.push_back(j);
+    if (j < best) {
+      best = j;
+      best_theta = theta;
+    }
+    if (options.on_evaluation) options.on_evaluation(static_cast<int>(fit.history.size()), j);
+    return j;
+  };
+  using Objective = decltype(objective);
+  nlopt::opt opt(n == 1 ? nlopt::LN_SBPLX : nlopt::LN_BOBYQA, static_cast<unsigned>(n));
+  const double bound = std::log(options.bound_factor);
+  opt.set_lower_bounds(std::vector<double>(n, -bound));
+  opt.set_upper_bounds(std::vector<double>(n, bound));
+  opt.set_initial_step(std::min(0.5, 0.5 * bound));
+  opt.set_xtol_abs(options.tolerance);
+  opt.set_maxeval(options.max_evaluations);
+  opt.set_min_objective([](const std::vector<double>& theta, std::vector<double>&,
+                           void* data) { return (*static_cast<Objective*>(data))(theta); },
+                        &objective);
+  std::vector<double> theta(n, 0.0);
+  double value = 0;
+  try {
+    const nlopt::result r = opt.optimize(theta, value);
+    fit.converged = is_converged(r);
+    fit.stop_reason = stop_reason(r);
+  } catch (const nlopt::roundoff_limited&) {
+    fit.converged = true;  // no further progress possible at this precision
+    fit.stop_reason = "round-off limited: no further progress at double precision";
+  } catch (const std::exception& e) {
+    fit.converged = false;
+    fit.stop_reason = std::string("optimiser failed: ") + e.what();
+  }
+  fit.evaluations = static_cast<int>(fit.history.size());
+
+  const Eigen::VectorXd fitted = stiffness_at(best_theta);
+  fit.after.train = evaluate_all(train_models, problem, train, fitted);
+  fit.after.test = evaluate_all(test_models, problem, test, fitted);
+  fit.objective_after = objective_of(fit.after.train, options.force_weight);
+  fit.test_equilibria = test_models.x;
+  for (int g = 0; g < n; ++g) {
+    FittedGroup f;
+    f.group = groups[g];
+    double k_start = 0, k_case = 0, k_fit = 0;
+    for (int s = 0; s < network.num_springs(); ++s)
+      if (network.spring_group[s] == group_id[g]) {
+        ++f.springs;
+        k_start += start_stiffness[s];
+        k_case += case_stiffness[s];
+        k_fit += fitted[s];
+      }
+    f.start_stiffness_n_per_m = k_start / f.springs;
+    f.fitted_stiffness_n_per_m = k_fit / f.springs;
+    f.factor = k_fit / k_start;
+    // The case file's group scale for this group, times what the fit changed from the case.
+    double case_scale = 1.0;
+    for (const auto& [name, factor] : problem.parameters.mass_spring.group_scales)
+      if (name == groups[g]) case_scale *= factor;
+    f.case_factor = case_scale * k_fit / k_case;
+    fit.groups.push_back(f);
+  }
+  fit.time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return fit;
+}
+
+DampingFit fit_damping(const ms::MassSpringModel& model, const Eigen::VectorXd& x, double target) {
+  const FreeDofs dofs(model);
+  const int n = static_cast<int>(dofs.full_index.size());
+  if (n == 0) throw std::invalid_argument("fit_damping: every node is constrained");
+  ms::Triplets kt;
+  model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), kt, ms::Linearisation::exact);
+  Eigen::SparseMatrix<double> k = dofs.restrict(kt);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
+  if (ldlt.info() != Eigen::Success || (ldlt.vectorD().array() <= 0).any()) {
+    kt.clear();
+    model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), kt, ms::Linearisation::definite);
+    k = dofs.restrict(kt);
+    ldlt.compute(k);
+    if (ldlt.info() != Eigen::Success)
+      throw std::runtime_error("fit_damping: the stiffness at equilibrium is singular");
+  }
+  const Eigen::VectorXd all_mass = model.mass_per_dof();
+  Eigen::VectorXd mass(n);
+  for (int i = 0; i < n; ++i)
+    mass[i] = all_mass[dofs.full_index[i]];
+  // Inverse iteration converges to the mode of the smallest ω² = vᵀKv / vᵀMv.
+  Eigen::VectorXd v = Eigen::VectorXd::Ones(n);
+  double omega2 = 0;
+  for (int it = 0; it < 500; ++it) {
+    Eigen::VectorXd y = ldlt.solve(mass.cwiseProduct(v));
+    y /= std::sqrt(y.dot(mass.cwiseProduct(y)));
+    const double next = y.dot(k * y);
+    v = y;
+    if (it > 5 && std::abs(next - omega2) <= 1e-10 * next) {
+      omega2 = next;
+      break;
+    }
+    omega2 = next;
+  }
+  const double omega = std::sqrt(omega2);
+  // Modal ratio ζ(r) = vᵀC(r)v / (2ω vᵀMv), with vᵀMv = 1; C is linear in r: ζ(r) = ζ0 + r ζ1.
+  auto modal_ratio = [&](double r) {
+    ms::MassSpringModel copy = model;
+    const auto& net = copy.network();
+    Eigen::VectorXd d(net.num_springs());
+    for (int s = 0; s < net.num_springs(); ++s) {
+      const double ma = net.masses[net.springs(s, 0)], mb = net.masses[net.springs(s, 1)];
+      d[s] = 2.0 * r * std::sqrt(net.stiffness[s] * ma * mb / (ma + mb));
+    }
+    copy.set_damping(d);
+    ms::Triplets ct;
+    copy.add_dfdv_triplets(x, ct);
+    return v.dot(dofs.restrict(ct) * v) / (2.0 * omega);
+  };
+  DampingFit f;
+  f.target = target;
+  f.slowest_frequency_hz = omega / (2.0 * M_PI);
+  const double zeta0 = modal_ratio(0.0);
+  f.modal_ratio_per_unit_r = modal_ratio(1.0) - zeta0;
+  f.reachable = f.modal_ratio_per_unit_r > 1e-6 && target >= zeta0;
+  f.case_damping_ratio = f.reachable ? (target - zeta0) / f.modal_ratio_per_unit_r : 0.0;
+  return f;
+}
+
+}  // namespace msfem::compare

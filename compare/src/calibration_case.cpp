@@ -1,0 +1,277 @@
+#include "msfem/compare/calibration_case.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface_generators.hpp"
+#include "msfem/compare/case_run.hpp"
+#include "msfem/compare/content_hash.hpp"
+#include "msfem/compare/fem_cache.hpp"
+#include "msfem/compare/fem_run.hpp"
+
+namespace msfem::compare {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::string resolve_variant(const cases::CaseParameters& p, const CalibrationRequest& request) {
+  std::string variant = request.variant.value_or(p.calibration.variant);
+  if (variant.empty()) variant = p.mass_spring.variants.front();
+  const auto& defined = p.mass_spring.variants;
+  if (std::find(defined.begin(), defined.end(), variant) == defined.end()) {
+    std::string list;
+    for (const auto& v : defined)
+      list += (list.empty() ? "" : ", ") + v;
+    throw cases::InputError(p.file.string() + ": --variant " + variant +
+                            ": the case does not define it (mass spring/variants = " + list + ")");
+  }
+  return variant;
+}
+
+void check_loads(const cases::CaseParameters& p, const std::vector<cases::ToolLoad>& train,
+                 const std::vector<cases::ToolLoad>& test) {
+  const std::string file = p.file.string();
+  if (train.empty())
+    throw cases::InputError(file +
+                            ": calibration: the training set is empty (give --train or set "
+                            "calibration/train loads)");
+  for (const auto& a : test)
+    for (const auto& b : train)
+      if (a.same_as(b))
+        throw cases::InputError(file + ": calibration: load " + a.label() +
+                                " is both a training and a held-out load (held-out loads must "
+                                "differ from the training ones)");
+  auto check_unique = [&](const std::vector<cases::ToolLoad>& loads, const char* what) {
+    for (std::size_t i = 0; i < loads.size(); ++i)
+      for (std::size_t j = i + 1; j < loads.size(); ++j)
+        if (loads[i].same_as(loads[j]))
+          throw cases::InputError(file + ": calibration: load " + loads[i].label() +
+                                  " appears twice in the " + what + " set");
+  };
+  check_unique(train, "training");
+  check_unique(test, "held-out");
+}
+
+// The case with its tool enabled at every direction the loads use, as deep as the deepest load
+// (make_problem checks that depth against the model's size).
+Problem calibration_problem(cases::CaseParameters p, const std::vector<cases::ToolLoad>& loads) {
+  auto& tool = p.loads.tool;
+  tool.enabled = true;
+  tool.directions.clear();
+  tool.depth_m = 0.0;
+  for (const auto& l : loads) {
+    tool.depth_m = std::max(tool.depth_m, l.depth_m);
+    if (std::none_of(tool.directions.begin(), tool.directions.end(),
+                     [&](const Eigen::Vector3d& d) { return (d - l.direction).norm() < 1e-9; }))
+      tool.directions.push_back(l.direction);
+  }
+  return make_problem(p);
+}
+
+ToolPlacement placement_of(const Problem& problem, const cases::ToolLoad& load) {
+  const auto& directions = problem.parameters.loads.tool.directions;
+  for (std::size_t i = 0; i < directions.size(); ++i)
+    if ((directions[i] - load.direction).norm() < 1e-9)
+      return at_depth(problem.tools[i], load.depth_m);
+  throw std::logic_error("calibration: no tool placed for load " + load.label());
+}
+
+std::string load_key(const std::string& problem_key, const cases::ToolLoad& load) {
+  ContentHash h;
+  h.text("msfem-calibration-load-1").text(problem_key).matrix(load.direction).number(load.depth_m);
+  return h.hex();
+}
+
+double mesh_mass(const fem_reference::VolumeMesh& mesh, double density) {
+  double volume = 0;
+  for (Eigen::Index t = 0; t < mesh.num_tetrahedra(); ++t) {
+    const Eigen::Vector3d a = mesh.vertices.row(mesh.tetrahedra(t, 0));
+    const Eigen::Vector3d b = mesh.vertices.row(mesh.tetrahedra(t, 1));
+    const Eigen::Vector3d c = mesh.vertices.row(mesh.tetrahedra(t, 2));
+    const Eigen::Vector3d d = mesh.vertices.row(mesh.tetrahedra(t, 3));
+    volume += std::abs((b - a).cross(c - a).dot(d - a)) / 6.0;
+  }
+  return density * volume;
+}
+
+// The FEM of every load, from the cache where it is there.
+void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& train,
+                      const std::vector<cases::ToolLoad>& test, const CalibrationRequest& request,
+                      const Progress& progress) {
+  const Problem& problem = c.problem;
+  const std::string problem_key = fem_cache_key(problem, {});
+  std::vector<cases::ToolLoad> all = train;
+  all.insert(all.end(), test.begin(), test.end());
+  std::vector<std::optional<FemCacheEntry>> cached(all.size());
+  bool have_mesh = false;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (request.fem_cache_directory)
+      cached[i] = load_fem_cache(*request.fem_cache_directory, load_key(problem_key, all[i]));
+    if (cached[i] && !have_mesh) {
+      c.mesh = cached[i]->mesh;  // every load shares one mesh, refined near every tool
+      have_mesh = true;
+    }
+  }
+  if (!have_mesh) {
+    progress.stage("meshing the volume (Gmsh), refined near all " +
+                   std::to_string(problem.tools.size()) + " tool positions");
+    c.mesh = mesh_problem(problem, problem.tools);
+  }
+  const auto start = Clock::now();
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    LoadReference r;
+    r.load = all[i];
+    r.tool = placement_of(problem, all[i]);
+    if (cached[i]) {
+      ++c.fem_from_cache;
+      r.surface_displacement = cached[i]->solution.surface_displacement;
+      r.tool_force = cached[i]->solution.tool_force;
+    } else {
+      const FemSolution s = solve_fem(problem, c.mesh, r.tool);
+      ++c.fem_solves;
+      r.surface_displacement = s.surface_displacement;
+      r.tool_force = s.tool_force;
+      if (request.fem_cache_directory)
+        store_fem_cache(*request.fem_cache_directory, load_key(problem_key, all[i]),
+                        {c.mesh, s, {}});
+    }
+    const std::vector<bool> prescribed = prescribed_surface_vertices(problem, r.tool);
+    for (std::size_t v = 0; v < prescribed.size(); ++v)
+      if (!prescribed[v]) r.compared_vertices.push_back(static_cast<int>(v));
+    (i < train.size() ? c.train : c.test).push_back(std::move(r));
+    progress.advance("FEM reference per load (" + std::to_string(c.fem_from_cache) + " cached)",
+                     static_cast<int>(i + 1), static_cast<int>(all.size()), seconds_since(start));
+  }
+  c.fem_time_s = seconds_since(start);
+}
+
+// Group scales of the calibrated case: the case's own entries with the fitted groups replaced.
+std::string group_scales_assignment(const cases::CaseParameters& p,
+                                    const std::vector<FittedGroup>& fitted) {
+  std::vector<std::pair<std::string, double>> scales;
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (std::none_of(fitted.begin(), fitted.end(),
+                     [&](const FittedGroup& f) { return f.group == group; }))
+      scales.emplace_back(group, factor);
+  for (const auto& f : fitted)
+    scales.emplace_back(f.group, f.case_factor);
+  std::string text = "mass spring/group scales=";
+  char buffer[64];
+  for (std::size_t i = 0; i < scales.size(); ++i) {
+    std::snprintf(buffer, sizeof buffer, "%.10g", scales[i].second);
+    text += (i ? ", " : "") + scales[i].first + ":" + buffer;
+  }
+  return text;
+}
+
+VariantOnTest mean_on(const std::string& name, bool calibrated,
+                      const std::vector<LoadErrors>& errors) {
+  VariantOnTest v{name, calibrated, 0.0, 0.0};
+  for (const auto& e : errors) {
+    v.mean_rel_l2_error += e.rel_l2_error / errors.size();
+    v.mean_reaction_force_rel_error += e.reaction_force_rel_error / errors.size();
+  }
+  return v;
+}
+
+}  // namespace
+
+CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
+                               const CalibrationRequest& request) {
+  const auto start = Clock::now();
+  const Progress progress(request.quiet);
+  CaseCalibration c;
+  c.variant = resolve_variant(parameters, request);
+  const auto& defaults = parameters.calibration;
+  const std::vector<cases::ToolLoad> train = request.train.value_or(defaults.train);
+  const std::vector<cases::ToolLoad> test = request.test.value_or(defaults.test);
+  check_loads(parameters, train, test);
+  c.options.groups = request.groups.value_or(defaults.groups);
+  c.options.force_weight = defaults.force_weight;
+  c.options.max_evaluations = defaults.max_evaluations;
+  c.options.tolerance = defaults.tolerance;
+  c.options.bound_factor = defaults.bound_factor;
+  c.target_damping_ratio = defaults.target_damping_ratio;
+
+  progress.stage("loading the surface and placing the tool at every load's position");
+  std::vector<cases::ToolLoad> all = train;
+  all.insert(all.end(), test.begin(), test.end());
+  c.problem = calibration_problem(parameters, all);
+  solve_references(c, train, test, request, progress);
+
+  progress.stage("fitting " + c.variant + " (BOBYQA, at most " +
+                 std::to_string(c.options.max_evaluations) + " evaluations of " +
+                 std::to_string(train.size()) + " static solves)");
+  const auto fit_start = Clock::now();
+  CalibrationOptions options = c.options;
+  options.on_evaluation = [&](int evaluation, double) {
+    if (evaluation % 20 == 0)
+      progress.advance("calibration evaluations (upper bound)", evaluation, options.max_evaluations,
+                       seconds_since(fit_start));
+  };
+  c.fit = calibrate(c.problem, c.mesh, c.variant, c.train, c.test, options);
+  if (!c.fit.converged) c.notes.push_back("the optimiser did not converge: " + c.fit.stop_reason);
+
+  // The calibrated case, as calibrated.prm will state it; re-solving it checks that the file
+  // reproduces the fit, and gives the equilibrium the damping fit linearises about.
+  c.calibrated_overrides = request.overrides;
+  c.calibrated_overrides.push_back("calibration/variant=" + c.variant);
+  c.calibrated_overrides.push_back(group_scales_assignment(parameters, c.fit.groups));
+  Problem calibrated = c.problem;
+  calibrated.parameters.mass_spring.group_scales.clear();
+  for (const auto& f : c.fit.groups)
+    calibrated.parameters.mass_spring.group_scales.emplace_back(f.group, f.case_factor);
+  for (const auto& [group, factor] : parameters.mass_spring.group_scales)
+    if (std::none_of(c.fit.groups.begin(), c.fit.groups.end(),
+                     [&](const FittedGroup& f) { return f.group == group; }))
+      calibrated.parameters.mass_spring.group_scales.emplace_back(group, factor);
+  BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
+  Eigen::VectorXd x;
+  const LoadErrors check = evaluate_load(built, calibrated, c.train.front(), x);
+  if (std::abs(check.rel_l2_error - c.fit.after.train.front().rel_l2_error) >
+      1e-6 * std::max(1.0, check.rel_l2_error))
+    c.notes.push_back("calibrated.prm re-solved gives rel_l2_error " +
+                      std::to_string(check.rel_l2_error) + " on " + check.load +
+                      " where the fit had " +
+                      std::to_string(c.fit.after.train.front().rel_l2_error));
+  c.damping = fit_damping(*built.model, x, c.target_damping_ratio);
+  if (c.damping.reachable) {
+    char ratio[64];
+    std::snprintf(ratio, sizeof ratio, "%.6g", c.damping.case_damping_ratio);
+    c.calibrated_overrides.push_back(std::string("mass spring/damping ratio=") + ratio);
+  } else {
+    c.notes.push_back("damping: spring dampers cannot give the slowest mode the target ratio");
+  }
+  if (!cases::is_surface_generator(parameters.geometry.source))
+    c.calibrated_overrides.push_back(
+        "geometry/source=" + std::filesystem::absolute(parameters.geometry.source).string());
+  c.lumped_mass_kg = built.model->network().masses.sum();
+  c.fem_mass_kg = mesh_mass(c.mesh, parameters.material.density_kg_per_m3);
+
+  c.variants.push_back(mean_on(c.variant, true, c.fit.after.test));
+  if (request.compare_variants && !c.test.empty()) {
+    for (const auto& name : parameters.mass_spring.variants) {
+      if (name == c.variant) continue;
+      progress.stage("held-out loads on " + name + " (as the case has it) for comparison");
+      BuiltVariant other = build_variant(name, c.problem, c.mesh, c.test.front().tool);
+      std::vector<LoadErrors> errors;
+      for (const auto& r : c.test) {
+        Eigen::VectorXd xo;
+        errors.push_back(evaluate_load(other, c.problem, r, xo));
+      }
+      c.variants.push_back(mean_on(name, false, errors));
+    }
+  }
+  std::sort(c.variants.begin(), c.variants.end(),
+            [](const auto& a, const auto& b) { return a.mean_rel_l2_error < b.mean_rel_l2_error; });
+  if (c.test.empty()) c.notes.push_back("no held-out loads: the fit is not checked on new loads");
+  c.total_time_s = seconds_since(start);
+  return c;
+}
+
+}  // namespace msfem::compare

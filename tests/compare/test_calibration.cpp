@@ -1,0 +1,185 @@
+// Calibration against data whose answer is known: a mass-spring model with chosen coefficients
+// stands in for the FEM, and the fit, started 2-3x off, has to find the coefficients again.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/compare/calibration.hpp"
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
+
+namespace msfem::compare {
+namespace {
+
+cases::CaseParameters sphere_case() {
+  cases::CaseParameters p;
+  p.name = "recovery";
+  p.file = "recovery.prm";
+  p.geometry.source = "icosphere:2:0.05";
+  p.support.kind = cases::SupportParameters::Kind::inner_core;
+  p.support.inner_core_scale = 2.0;
+  p.loads.tool.radius_m = 0.008;
+  p.loads.tool.depth_m = 0.004;
+  p.loads.tool.directions = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(),
+                             Eigen::Vector3d(0, -1, 0.5).normalized()};
+  p.mass_spring.variants = {"three_tier"};
+  return p;
+}
+
+// "FEM" data: the three-tier model with the given group scales, solved on each tool.
+std::vector<LoadReference> synthetic_references(const Problem& truth) {
+  std::vector<LoadReference> refs;
+  const fem_reference::VolumeMesh no_mesh;
+  const double depths[] = {0.004, 0.003, 0.0035};
+  for (std::size_t i = 0; i < truth.tools.size(); ++i) {
+    LoadReference r;
+    r.load = {truth.parameters.loads.tool.directions[i], depths[i]};
+    r.tool = at_depth(truth.tools[i], depths[i]);
+    BuiltVariant v = build_variant("three_tier", truth, no_mesh, r.tool);
+    const StaticSolution s = solve_variant_static(v);
+    r.surface_displacement = s.surface_displacement;
+    r.tool_force = s.tool_force;
+    for (Eigen::Index vertex = 0; vertex < truth.surface.num_vertices(); ++vertex)
+      if (std::find(v.tool_patch.begin(), v.tool_patch.end(), vertex) == v.tool_patch.end() &&
+          !truth.fixed_region(truth.surface.vertices.row(vertex).transpose()))
+        r.compared_vertices.push_back(static_cast<int>(vertex));
+    refs.push_back(r);
+  }
+  return refs;
+}
+
+TEST(Calibration, RecoversKnownCoefficientsFromAStartTwoToThreeTimesOff) {
+  const std::vector<std::string> groups = {"tier1_edges", "tier2_edges", "tier12_diagonals",
+                                           "tier12_radial", "tier23_radial"};
+  const std::vector<double> truth = {1.3, 0.8, 1.1, 0.9, 1.6};
+  const std::vector<double> start_off = {2.5, 0.4, 2.0, 1.0 / 3.0, 2.2};  // start / truth
+  cases::CaseParameters p = sphere_case();
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    p.mass_spring.group_scales.emplace_back(groups[g], truth[g]);
+  const Problem truth_problem = make_problem(p);
+  const std::vector<LoadReference> refs = synthetic_references(truth_problem);
+
+  // The same case with the analytic stiffness (no group scales), started far from the truth.
+  cases::CaseParameters analytic = sphere_case();
+  const Problem problem = make_problem(analytic);
+  CalibrationOptions options;
+  options.groups = groups;
+  options.tolerance = 1e-7;
+  options.max_evaluations = 2000;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    options.start_factors.push_back(truth[g] * start_off[g]);
+  const std::vector<LoadReference> train(refs.begin(), refs.begin() + 2);
+  const std::vector<LoadReference> test(refs.begin() + 2, refs.end());
+  const CalibrationFit fit = calibrate(problem, {}, "three_tier", train, test, options);
+
+  ASSERT_EQ(fit.groups.size(), groups.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    // case_factor: fitted stiffness over the analytic one (the case has no group scales).
+    EXPECT_NEAR(fit.groups[g].case_factor / truth[g], 1.0, 0.01) << groups[g];
+    EXPECT_NEAR(fit.groups[g].factor * options.start_factors[g] / truth[g], 1.0, 0.01) << groups[g];
+  }
+  EXPECT_GT(fit.before.train[0].rel_l2_error, 0.05);
+  EXPECT_LT(fit.after.train[0].rel_l2_error, 1e-3);
+  EXPECT_LT(fit.after.test[0].rel_l2_error, 1e-3);  // the held-out load: the truth generalises
+  EXPECT_LT(fit.after.test[0].reaction_force_rel_error, 1e-3);
+  EXPECT_LT(fit.objective_after, 1e-4 * fit.objective_before);
+  EXPECT_EQ(fit.history.size(), static_cast<std::size_t>(fit.evaluations));
+}
+
+TEST(Calibration, RejectsUnknownGroupsAndAnEmptyTrainingSet) {
+  const Problem problem = make_problem(sphere_case());
+  const auto refs = synthetic_references(problem);
+  CalibrationOptions options;
+  options.groups = {"tier1_edges", "no_such_group"};
+  try {
+    calibrate(problem, {}, "three_tier", refs, {}, options);
+    FAIL() << "an unknown group was accepted";
+  } catch (const cases::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_group"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("tier12_radial"), std::string::npos) << e.what();
+  }
+  options.groups = {};
+  EXPECT_THROW(calibrate(problem, {}, "three_tier", {}, refs, options), cases::InputError);
+}
+
+TEST(Calibration, StopsAtTheEvaluationLimitAndKeepsTheBestPoint) {
+  cases::CaseParameters p = sphere_case();
+  p.mass_spring.group_scales = {{"tier1_edges", 2.0}};
+  const auto refs = synthetic_references(make_problem(p));
+  CalibrationOptions options;
+  options.groups = {"tier1_edges", "tier2_edges"};
+  options.max_evaluations = 4;
+  const CalibrationFit fit =
+      calibrate(make_problem(sphere_case()), {}, "three_tier", refs, {}, options);
+  EXPECT_FALSE(fit.converged);
+  EXPECT_NE(fit.stop_reason.find("evaluation limit"), std::string::npos) << fit.stop_reason;
+  EXPECT_EQ(fit.evaluations, 4);
+  // The point kept is the best one evaluated, never worse than the start.
+  const double best = *std::min_element(fit.history.begin(), fit.history.end());
+  EXPECT_LE(fit.objective_after, std::min(best, fit.objective_before) * (1 + 1e-9));
+}
+
+// A free node of mass m held by six equal springs to fixed nodes of mass m_a on ±x, ±y, ±z: K = 2k
+// I, so every mode has ω² = 2k/m, and C = 2d I with d = 2 r √(k μ), μ = m_a m/(m_a+m), gives the
+// modal ratio ζ = d/(ω m) = r √(2μ/m). The fitted r must also damp a simulated free vibration so.
+TEST(Calibration, DampingFitMatchesTheSixSpringOscillatorAndItsFreeVibration) {
+  const double k = 50.0, m = 0.2, m_a = 0.3, length = 0.01;
+  massspring::SpringNetwork n;
+  n.rest_positions.resize(7, 3);
+  n.rest_positions.setZero();
+  for (int a = 0; a < 3; ++a) {
+    n.rest_positions(1 + 2 * a, a) = length;
+    n.rest_positions(2 + 2 * a, a) = -length;
+  }
+  n.masses = Eigen::VectorXd::Constant(7, m_a);
+  n.masses[0] = m;
+  n.node_damping = Eigen::VectorXd::Zero(7);
+  n.node_group = Eigen::VectorXi::Zero(7);
+  n.node_group_names = {"all"};
+  n.springs.resize(6, 2);
+  for (int s = 0; s < 6; ++s)
+    n.springs.row(s) << 0, s + 1;
+  n.stiffness = Eigen::VectorXd::Constant(6, k);
+  n.damping = Eigen::VectorXd::Zero(6);
+  n.rest_length = Eigen::VectorXd::Constant(6, length);
+  n.spring_group = Eigen::VectorXi::Zero(6);
+  n.spring_group_names = {"s"};
+  massspring::MassSpringModel model(n);
+  for (int node = 1; node < 7; ++node)
+    model.fix_node(node);
+
+  const double target = 0.1;
+  const DampingFit fit = fit_damping(model, model.initial_state(), target);
+  const double omega = std::sqrt(2 * k / m), mu = m_a * m / (m_a + m);
+  EXPECT_NEAR(fit.slowest_frequency_hz, omega / (2 * M_PI), 1e-8 * omega);
+  EXPECT_NEAR(fit.modal_ratio_per_unit_r, std::sqrt(2 * mu / m), 1e-8);
+  EXPECT_NEAR(fit.case_damping_ratio, target / std::sqrt(2 * mu / m), 1e-8);
+  ASSERT_TRUE(fit.reachable);
+
+  // Free vibration with the fitted damping: the logarithmic decrement gives ζ back.
+  Eigen::VectorXd d(6);
+  for (int s = 0; s < 6; ++s)
+    d[s] = 2 * fit.case_damping_ratio * std::sqrt(k * mu);
+  model.set_damping(d);
+  massspring::State state = massspring::initial_state(model);
+  state.x[0] = 1e-5;  // small: the springs stay linear
+  const double period = 2 * M_PI / omega, dt = period / 2000;
+  massspring::Integrator rk4(massspring::IntegratorKind::rk4);
+  std::vector<double> peaks;
+  double previous = state.x[0], before_previous = state.x[0];
+  for (int step = 0; step < 8000 && peaks.size() < 3; ++step) {
+    rk4.step(model, state, dt);
+    if (previous > before_previous && previous > state.x[0] && previous > 0)
+      peaks.push_back(previous);
+    before_previous = previous;
+    previous = state.x[0];
+  }
+  ASSERT_EQ(peaks.size(), 3u);
+  const double delta = std::log(peaks[0] / peaks[1]);
+  const double zeta = delta / std::sqrt(4 * M_PI * M_PI + delta * delta);
+  EXPECT_NEAR(zeta, target, 0.01 * target);
+}
+
+}  // namespace
+}  // namespace msfem::compare
