@@ -1,0 +1,103 @@
+// `msfem calibrate` end to end on a small sphere: the case's defaults, the JSON a script reads,
+// calibrated.prm loading in `msfem run`, and bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+
+namespace msfem {
+namespace {
+
+using testing::count_lines;
+using testing::read_text;
+using testing::run_msfem;
+using testing::TemporaryDirectory;
+
+const std::string small_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_calibrate.prm";
+
+TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "cal";
+  const auto r = run_msfem("calibrate " + small_case + " --quiet --json --out " + out.string() +
+                           " --set output/directory=" + (tmp / "runs").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["variant"], "three_tier");
+  for (const char* side : {"before", "after"}) {
+    ASSERT_EQ(j[side]["train"].size(), 2u) << side;
+    ASSERT_EQ(j[side]["test"].size(), 1u) << side;
+    for (const char* set : {"train", "test"})
+      for (const auto& e : j[side][set])
+        for (const char* key :
+             {"rel_l2_error", "mean_error_over_max_disp", "reaction_force_rel_error"})
+          EXPECT_TRUE(e[key].is_number() && std::isfinite(e[key].get<double>()))
+              << side << "/" << set << "/" << key;
+  }
+  EXPECT_LT(j["after"]["objective"].get<double>(), j["before"]["objective"].get<double>());
+  ASSERT_EQ(j["coefficients"].size(), 3u);
+  EXPECT_EQ(j["coefficients"][0]["group"], "tier1_edges");
+  EXPECT_TRUE(j["optimiser"]["converged"].get<bool>());
+  EXPECT_EQ(j["optimiser"]["history"].size(), j["optimiser"]["evaluations"].get<std::size_t>());
+  EXPECT_NEAR(j["mass"]["ratio"].get<double>(), 1.0, 0.05);
+  EXPECT_EQ(nlohmann::json::parse(read_text(out / "calibration.json")), j);
+  EXPECT_TRUE(std::filesystem::exists(out / "report.md"));
+
+  // calibrated.prm is a case: `msfem run` loads it and builds the fitted stiffness.
+  const auto run_dir = tmp / "run";
+  const auto run = run_msfem("run " + (out / "calibrated.prm").string() +
+                             " --quiet --no-timing --no-curve --out " + run_dir.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto summary = nlohmann::json::parse(read_text(run_dir / "summary.json"));
+  for (const auto& v : summary["variants"]) {
+    if (v["name"] != "three_tier") continue;
+    for (const auto& c : j["coefficients"]) {
+      const double built = v["parameters"]["spring_groups"][c["group"].get<std::string>()]
+                            ["mean_stiffness_n_per_m"];
+      EXPECT_NEAR(built / c["fitted_stiffness_N_per_m"].get<double>(), 1.0, 1e-6) << c["group"];
+    }
+  }
+}
+
+TEST(CliCalibrate, BadInputIsOneLineAndLeavesNoResultFolder) {
+  TemporaryDirectory tmp;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--fit tier1_edges,no_such_group", "no_such_group"},
+      {"--train ''", "training set is empty"},
+      {"--train '0,0,1@0.004' --test '0,0,1@0.004'", "both a training and a held-out"},
+      {"--variant skeleton", "skeleton"},
+      {"--variant four_tier", "four_tier"},
+      {"--train '0,0,1'", "DX,DY,DZ@DEPTH"},
+      {"--train '0,0,0@0.004'", "DX,DY,DZ@DEPTH"},
+      {"--set 'calibration/train loads=0,0,1@-1'", "calibration/train loads"},
+  };
+  for (const auto& [options, named] : cases) {
+    const auto out = tmp / "out";
+    const auto r = run_msfem("calibrate " + small_case + " --quiet --no-cache " + options +
+                             " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << options << ": " << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(named), std::string::npos) << options << ": " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << options;
+  }
+}
+
+TEST(CliCalibrate, AnOptimiserThatDoesNotConvergeKeepsTheBestPointAndFailsUnderStrict) {
+  TemporaryDirectory tmp;
+  const auto lenient = run_msfem("calibrate " + small_case + " --quiet --no-cache --json " +
+                                 "--no-compare --max-evaluations 3 --out " + (tmp / "a").string());
+  ASSERT_EQ(lenient.exit_code, 0) << lenient.err;
+  EXPECT_NE(lenient.err.find("did not converge"), std::string::npos) << lenient.err;
+  const auto j = nlohmann::json::parse(lenient.out);
+  EXPECT_FALSE(j["optimiser"]["converged"].get<bool>());
+  EXPECT_LE(j["after"]["objective"].get<double>(), j["before"]["objective"].get<double>());
+
+  const auto strict = run_msfem("calibrate " + small_case + " --quiet --no-cache --strict " +
+                                "--no-compare --max-evaluations 3 --out " + (tmp / "b").string());
+  EXPECT_EQ(strict.exit_code, 1) << strict.err;
+  EXPECT_TRUE(std::filesystem::exists(tmp / "b" / "calibrated.prm"));  // the best point, kept
+}
+
+}  // namespace
+}  // namespace msfem
