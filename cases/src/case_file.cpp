@@ -176,7 +176,11 @@ void declare_calibration(ParameterHandler& prm) {
   prm.declare_entry("bound factor", "100", Patterns::Double(1.0),
                     "Each fitted factor stays within [1/b, b] of its starting value.");
   prm.declare_entry("target damping ratio", "0.5", Patterns::Double(0),
-                    "Damping ratio of the slowest mode that the damping fit aims for.");
+                    "Damping ratio of the tool-response mode that the damping fit aims for.");
+  prm.declare_entry("model", "nonlinear", Patterns::Selection("nonlinear|linear"),
+                    "Spring model the fit solves: nonlinear static equilibrium (Newton, as msfem "
+                    "run), or linearised at rest (one Cholesky factorisation per load and "
+                    "evaluation: large models, small indentations).");
   prm.leave_subsection();
 }
 
@@ -353,6 +357,7 @@ CaseParameters extract(ParameterHandler& prm) {
   cal.tolerance = prm.get_double("tolerance");
   cal.bound_factor = prm.get_double("bound factor");
   cal.target_damping_ratio = prm.get_double("target damping ratio");
+  cal.model = prm.get("model");
   prm.leave_subsection();
   if (!cal.variant.empty() &&
       std::find(ms.variants.begin(), ms.variants.end(), cal.variant) == ms.variants.end())

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <nlopt.hpp>
 #include <stdexcept>
 
+#include "linearised_statics.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/metrics.hpp"
 #include "msfem/massspring/errors.hpp"
@@ -58,7 +60,21 @@ double objective_of(const std::vector<LoadErrors>& errors, double force_weight) 
 struct LoadModels {
   std::vector<BuiltVariant> variants;
   std::vector<Eigen::VectorXd> x;
+  std::vector<std::unique_ptr<LinearisedStatics>> linear;  ///< the fast path, when asked for
 };
+
+LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d& displacement,
+                          const Eigen::Vector3d& force) {
+  LoadErrors e;
+  e.load = reference.load.label();
+  const ErrorMetrics m =
+      displacement_error(displacement, reference.surface_displacement, reference.compared_vertices);
+  e.rel_l2_error = m.rel_l2_error;
+  e.mean_error_over_max_disp = m.mean_error_over_max_disp;
+  e.tool_force = force;
+  e.reaction_force_rel_error = reaction_force_rel_error(force, reference.tool_force);
+  return e;
+}
 
 LoadModels models_for(const BuiltVariant& base, const Problem& problem,
                       const std::vector<LoadReference>& references) {
@@ -81,7 +97,6 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const Problem& problem,
   std::vector<LoadErrors> errors;
   for (std::size_t i = 0; i < references.size(); ++i) {
     m.variants[i].model->set_stiffness(stiffness);
-    m.x[i].resize(0);  // cold start: see the note in calibrate()
     errors.push_back(evaluate_load(m.variants[i], problem, references[i], m.x[i]));
   }
   return errors;
@@ -118,15 +133,7 @@ LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
   set_tool_depth(variant, problem, reference.tool);
   const StaticSolution s = solve_variant_static(variant, x);
   x = s.x;
-  LoadErrors e;
-  e.load = reference.load.label();
-  const ErrorMetrics m = displacement_error(s.surface_displacement, reference.surface_displacement,
-                                            reference.compared_vertices);
-  e.rel_l2_error = m.rel_l2_error;
-  e.mean_error_over_max_disp = m.mean_error_over_max_disp;
-  e.tool_force = s.tool_force;
-  e.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, reference.tool_force);
-  return e;
+  return errors_against(reference, s.surface_displacement, s.tool_force);
 }
 
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
@@ -177,9 +184,34 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
 
   LoadModels train_models = models_for(base, problem, train);
   LoadModels test_models = models_for(base, problem, test);
+  if (options.linear) {
+    // Part 0: the springs not fitted (weight 1); part g + 1: fitted group g (weight exp θ_g).
+    std::vector<Eigen::VectorXd> parts(n + 1, Eigen::VectorXd::Zero(network.num_springs()));
+    for (int s = 0; s < network.num_springs(); ++s) {
+      const auto it = std::find(group_id.begin(), group_id.end(), network.spring_group[s]);
+      parts[it == group_id.end() ? 0 : 1 + (it - group_id.begin())][s] = start_stiffness[s];
+    }
+    for (LoadModels* m : {&train_models, &test_models})
+      for (const auto& v : m->variants)
+        m->linear.push_back(std::make_unique<LinearisedStatics>(*v.model, parts));
+  }
+  auto evaluate = [&](LoadModels& m, const std::vector<LoadReference>& references,
+                      const std::vector<double>& theta) {
+    if (!options.linear) return evaluate_all(m, problem, references, stiffness_at(theta));
+    std::vector<double> weights(n + 1, 1.0);
+    for (int g = 0; g < n; ++g)
+      weights[g + 1] = std::exp(theta[g]);
+    std::vector<LoadErrors> errors;
+    for (std::size_t i = 0; i < references.size(); ++i) {
+      const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
+      errors.push_back(errors_against(references[i], s.surface_displacement, s.patch_force));
+    }
+    return errors;
+  };
   CalibrationFit fit;
-  fit.before.train = evaluate_all(train_models, problem, train, start_stiffness);
-  fit.before.test = evaluate_all(test_models, problem, test, start_stiffness);
+  const std::vector<double> zero(n, 0.0);
+  fit.before.train = evaluate(train_models, train, zero);
+  fit.before.test = evaluate(test_models, test, zero);
   fit.objective_before = objective_of(fit.before.train, options.force_weight);
 
   std::vector<double> best_theta(n, 0.0);
@@ -187,8 +219,7 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   auto objective = [&](const std::vector<double>& theta) {
     double j = failed_objective;
     try {
-      j = objective_of(evaluate_all(train_models, problem, train, stiffness_at(theta)),
-                       options.force_weight);
+      j = objective_of(evaluate(train_models, train, theta), options.force_weight);
     } catch (const std::runtime_error&) {
       // Newton failed at this trial point: steer the optimiser away from it.
     }
@@ -227,8 +258,8 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   fit.evaluations = static_cast<int>(fit.history.size());
 
   const Eigen::VectorXd fitted = stiffness_at(best_theta);
-  fit.after.train = evaluate_all(train_models, problem, train, fitted);
-  fit.after.test = evaluate_all(test_models, problem, test, fitted);
+  fit.after.train = evaluate(train_models, train, best_theta);
+  fit.after.test = evaluate(test_models, test, best_theta);
   fit.objective_after = objective_of(fit.after.train, options.force_weight);
   fit.test_equilibria = test_models.x;
   for (int g = 0; g < n; ++g) {
@@ -256,40 +287,50 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   return fit;
 }
 
-DampingFit fit_damping(const ms::MassSpringModel& model, const Eigen::VectorXd& x, double target) {
+DampingFit fit_damping(const ms::MassSpringModel& model, const Eigen::VectorXd& x, double target,
+                       const Eigen::VectorXd& shape) {
   const FreeDofs dofs(model);
   const int n = static_cast<int>(dofs.full_index.size());
   if (n == 0) throw std::invalid_argument("fit_damping: every node is constrained");
   ms::Triplets kt;
   model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), kt, ms::Linearisation::exact);
   Eigen::SparseMatrix<double> k = dofs.restrict(kt);
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
-  if (ldlt.info() != Eigen::Success || (ldlt.vectorD().array() <= 0).any()) {
-    kt.clear();
-    model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), kt, ms::Linearisation::definite);
-    k = dofs.restrict(kt);
-    ldlt.compute(k);
-    if (ldlt.info() != Eigen::Success)
-      throw std::runtime_error("fit_damping: the stiffness at equilibrium is singular");
-  }
   const Eigen::VectorXd all_mass = model.mass_per_dof();
   Eigen::VectorXd mass(n);
   for (int i = 0; i < n; ++i)
     mass[i] = all_mass[dofs.full_index[i]];
-  // Inverse iteration converges to the mode of the smallest ω² = vᵀKv / vᵀMv.
-  Eigen::VectorXd v = Eigen::VectorXd::Ones(n);
+  Eigen::VectorXd v(n);
   double omega2 = 0;
-  for (int it = 0; it < 500; ++it) {
-    Eigen::VectorXd y = ldlt.solve(mass.cwiseProduct(v));
-    y /= std::sqrt(y.dot(mass.cwiseProduct(y)));
-    const double next = y.dot(k * y);
-    v = y;
-    if (it > 5 && std::abs(next - omega2) <= 1e-10 * next) {
-      omega2 = next;
-      break;
+  if (shape.size() == model.num_dofs()) {
+    for (int i = 0; i < n; ++i)
+      v[i] = shape[dofs.full_index[i]];
+    const double norm = std::sqrt(v.dot(mass.cwiseProduct(v)));
+    if (!(norm > 0)) throw std::invalid_argument("fit_damping: the mode shape is zero");
+    v /= norm;
+    omega2 = v.dot(k * v);
+  } else {
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
+    if (ldlt.info() != Eigen::Success || (ldlt.vectorD().array() <= 0).any()) {
+      kt.clear();
+      model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), kt, ms::Linearisation::definite);
+      k = dofs.restrict(kt);
+      ldlt.compute(k);
+      if (ldlt.info() != Eigen::Success)
+        throw std::runtime_error("fit_damping: the stiffness at equilibrium is singular");
     }
-    omega2 = next;
+    // Inverse iteration converges to the mode of the smallest ω² = vᵀKv / vᵀMv.
+    v.setOnes();
+    for (int it = 0; it < 500; ++it) {
+      Eigen::VectorXd y = ldlt.solve(mass.cwiseProduct(v));
+      y /= std::sqrt(y.dot(mass.cwiseProduct(y)));
+      const double next = y.dot(k * y);
+      v = y;
+      const bool settled = it > 5 && std::abs(next - omega2) <= 1e-10 * next;
+      omega2 = next;
+      if (settled) break;
+    }
   }
+  if (!(omega2 > 0)) throw std::runtime_error("fit_damping: the mode has no stiffness");
   const double omega = std::sqrt(omega2);
   // Modal ratio ζ(r) = vᵀC(r)v / (2ω vᵀMv), with vᵀMv = 1; C is linear in r: ζ(r) = ζ0 + r ζ1.
   auto modal_ratio = [&](double r) {
@@ -307,10 +348,11 @@ DampingFit fit_damping(const ms::MassSpringModel& model, const Eigen::VectorXd& 
   };
   DampingFit f;
   f.target = target;
-  f.slowest_frequency_hz = omega / (2.0 * M_PI);
+  f.frequency_hz = omega / (2.0 * M_PI);
   const double zeta0 = modal_ratio(0.0);
   f.modal_ratio_per_unit_r = modal_ratio(1.0) - zeta0;
-  f.reachable = f.modal_ratio_per_unit_r > 1e-6 && target >= zeta0;
+  // Beyond r = 1000 the dampers would dominate every other mode: not a sensible fit.
+  f.reachable = f.modal_ratio_per_unit_r > 1e-3 * std::max(target - zeta0, 0.0) && target >= zeta0;
   f.case_damping_ratio = f.reachable ? (target - zeta0) / f.modal_ratio_per_unit_r : 0.0;
   return f;
 }

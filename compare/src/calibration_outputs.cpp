@@ -86,6 +86,10 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
      << c.options.force_weight
      << " (under a prescribed tool the displacement fixes the stiffness ratios, the force their "
         "overall scale)\n"
+     << "- spring model solved: "
+     << (c.options.linear ? "linearised at rest (one Cholesky factorisation per load)"
+                          : "nonlinear static equilibrium (Newton, as `msfem run`)")
+     << "\n"
      << "- optimiser: NLopt BOBYQA on log(k/k_start) within ±log(" << c.options.bound_factor
      << "), start = the analytic stiffness with the case's group scales; " << fit.evaluations
      << " evaluations in " << fmt("%.1f", fit.time_s) << " s; "
@@ -103,8 +107,9 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
      << fmt("%.4f", mean_of(fit.after.test, &LoadErrors::reaction_force_rel_error)) << ".\n\n";
   md << "## Fitted coefficients\n\n" << coefficients_table(c) << "\n";
   md << "## Damping and mass\n\n"
-     << "- slowest mode of the calibrated model under the first training load: "
-     << fmt("%.4g", c.damping.slowest_frequency_hz) << " Hz; its damping ratio is "
+     << "- tool-response mode of the calibrated model (its static deflection under the first "
+        "training load, as a Rayleigh quotient): "
+     << fmt("%.4g", c.damping.frequency_hz) << " Hz; its damping ratio is "
      << fmt("%.4g", c.damping.modal_ratio_per_unit_r)
      << " per unit of the per-spring damping ratio, so "
      << (c.damping.reachable ? "`damping ratio = " + fmt("%.4g", c.damping.case_damping_ratio) +
@@ -171,7 +176,7 @@ nlohmann::json calibration_json(const CaseCalibration& c) {
           {"coefficients", coefficients},
           {"damping",
            {{"target_modal_damping_ratio", c.damping.target},
-            {"slowest_frequency_hz", c.damping.slowest_frequency_hz},
+            {"mode_frequency_hz", c.damping.frequency_hz},
             {"modal_ratio_per_unit_damping_ratio", c.damping.modal_ratio_per_unit_r},
             {"damping_ratio", c.damping.case_damping_ratio},
             {"reachable", c.damping.reachable}}},

@@ -40,6 +40,28 @@ Eigen::MatrixX3d inner_tier(const Eigen::MatrixX3d& vertices, const Eigen::Matri
 }
 
 // Reports inner-tier nodes found outside the next outer tier.
+// The volume a shell's springs share: the difference of the enclosed volumes, unless the inner tier
+// is not nested in the outer one (a concave surface offset inward folds over, and its enclosed
+// volume can exceed the outer's: the brain's tier 3 does), when the clamped difference would give
+// the shell's springs no stiffness at all. Then the prisms between corresponding vertices, mean
+// vertex area × distance, which are positive by construction.
+double stiffness_volume(SpringNetwork& network, const Eigen::MatrixX3d& outer,
+                        const Eigen::MatrixX3d& inner, const Eigen::MatrixX3i& triangles,
+                        double enclosed_difference, const std::string& shell) {
+  const Eigen::VectorXd outer_areas = vertex_areas(outer, triangles);
+  const Eigen::VectorXd inner_areas = vertex_areas(inner, triangles);
+  double prisms = 0.0;
+  for (Eigen::Index i = 0; i < outer.rows(); ++i)
+    prisms += 0.5 * (outer_areas[i] + inner_areas[i]) * (outer.row(i) - inner.row(i)).norm();
+  if (enclosed_difference > 0.25 * prisms) return enclosed_difference;
+  network.warnings.push_back("the shell between " + shell + " encloses " +
+                             std::to_string(enclosed_difference) +
+                             " m^3 by volume difference (tiers not nested); its springs' stiffness "
+                             "uses the vertex prisms' volume, " +
+                             std::to_string(prisms) + " m^3");
+  return prisms;
+}
+
 void check_nesting(SpringNetwork& network, const Eigen::MatrixX3d& inner,
                    const Eigen::MatrixX3d& outer, const Eigen::MatrixX3i& triangles,
                    const char* inner_name, const char* outer_name, bool reject) {
@@ -123,8 +145,12 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   }
 
   const double modulus = options.material.youngs_modulus;
-  detail::assign_network_stiffness(network, {g1, g2, g12, r12}, modulus, shell12);
-  detail::assign_network_stiffness(network, {r23}, modulus, shell23);
+  detail::assign_network_stiffness(
+      network, {g1, g2, g12, r12}, modulus,
+      stiffness_volume(network, vertices, tier2, triangles, shell12, "tier 1 and tier 2"));
+  detail::assign_network_stiffness(
+      network, {r23}, modulus,
+      stiffness_volume(network, tier2, tier3, triangles, shell23, "tier 2 and tier 3"));
   detail::assign_damping(network, options.material);
 
   for (int i = 0; i < nv; ++i) {

@@ -81,6 +81,36 @@ TEST(ThreeTier, DetectsInnerTierOutsideAConcaveSurface) {
   EXPECT_TRUE(offset_network.warnings.empty());
 }
 
+// An inner tier offset past the centre turns inside out, and its enclosed volume no longer sits
+// inside the middle tier's (the brain's offset tier 3 folds the same way in its sulci). The shell's
+// springs must keep a stiffness: from the vertex prisms, the same as an unfolded shell of equal
+// thickness would get from its volume to within the prisms' approximation.
+TEST(ThreeTier, FoldedInnerTierKeepsItsShellStiffness) {
+  const auto mesh = icosphere(3, 0.05);
+  ThreeTierOptions folded;
+  folded.inner_tiers = InnerTierMethod::normal_offset;
+  folded.tier2_offset = 0.01;   // tier 2 at r = 0.04
+  folded.tier3_offset = 0.085;  // tier 3 through the centre: r = -0.035, inside out
+  const SpringNetwork network = build_three_tier(mesh.vertices, mesh.triangles, folded);
+  const int r23 = network.spring_group_id("tier23_radial");
+  double sum = 0;
+  int count = 0;
+  for (int s = 0; s < network.num_springs(); ++s)
+    if (network.spring_group[s] == r23) {
+      EXPECT_GT(network.stiffness[s], 0.0) << s;
+      sum += network.stiffness[s];
+      ++count;
+    }
+  EXPECT_EQ(count, 642);
+  EXPECT_TRUE(std::any_of(network.warnings.begin(), network.warnings.end(),
+                          [](const auto& w) { return w.find("prisms") != std::string::npos; }));
+  // Prism volume: Σ (A2 + A3)/2 × 0.075 with A2 = 4π 0.04², A3 = 4π 0.035² (areas of the tiers).
+  const double prisms = 0.5 * 4 * M_PI * (0.04 * 0.04 + 0.035 * 0.035) * 0.075;
+  const Eigen::VectorXd lengths = Eigen::VectorXd::Constant(642, 0.075);
+  const double expected = isotropic_network_stiffness(3000.0, prisms, lengths)[0];
+  EXPECT_NEAR(sum / count / expected, 1.0, 0.03);
+}
+
 TEST(SingleLayer, SurfaceEdgesAndAnchors) {
   const auto mesh = icosphere(3, 0.05);
   const SpringNetwork network = build_single_layer(mesh.vertices, mesh.triangles);

@@ -119,7 +119,8 @@ struct CalibrationParameters {
   int max_evaluations = 400;          ///< objective evaluations (each: one static solve per load)
   double tolerance = 1e-5;            ///< stop when a step changes every log coefficient by less
   double bound_factor = 100.0;        ///< each factor stays within [1/b, b] of its start
-  double target_damping_ratio = 0.5;  ///< of the slowest mode, for the damping fit
+  double target_damping_ratio = 0.5;  ///< of the tool-response mode, for the damping fit
+  std::string model = "nonlinear";    ///< nonlinear (Newton, as msfem run) | linear (at rest)
 };
 
 /// Parses "DX,DY,DZ@DEPTH; ..." (depth in metres); throws InputError naming `key` and the entry.

@@ -57,6 +57,9 @@ struct CalibrationOptions {
   int max_evaluations = 400;
   double tolerance = 1e-5;
   double bound_factor = 100.0;
+  /// Fit the model linearised at rest (one Cholesky factorisation per load and evaluation) instead
+  /// of the nonlinear static equilibrium (Newton): for large models and small indentations.
+  bool linear = false;
   /// Starting factors per fitted group (empty: 1, the analytic stiffness).
   std::vector<double> start_factors;
   /// Called after each evaluation with its number and objective (progress reports).
@@ -87,12 +90,14 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
 LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
                          const LoadReference& reference, Eigen::VectorXd& x);
 
-/// The damping ratio of the case's per-spring damping ("mass spring/damping ratio") that gives the
-/// slowest mode of the loaded model a modal damping ratio `target` (springs damp along their axis
-/// with d = 2 r sqrt(k m_ab/(m_a+m_b)), so the modal ratio is linear in r).
+/// The damping ratio of the case's per-spring damping ("mass spring/damping ratio") that gives a
+/// mode of the loaded model the modal damping ratio `target` (springs damp along their axis with d
+/// = 2 r sqrt(k m_a m_b/(m_a+m_b)), so the modal ratio is linear in r). The mode is `shape` (a
+/// full-dof vector, e.g. the tool's static deflection: the motion that settles after a press) taken
+/// as a Rayleigh quotient, or, when `shape` is empty, the slowest mode by inverse iteration.
 struct DampingFit {
-  double slowest_frequency_hz = 0.0;
-  double modal_ratio_per_unit_r = 0.0;  ///< the slowest mode's ratio with r = 1
+  double frequency_hz = 0.0;            ///< of the mode
+  double modal_ratio_per_unit_r = 0.0;  ///< the mode's ratio with r = 1
   double case_damping_ratio = 0.0;      ///< r that gives `target` (0 when not reachable)
   double target = 0.0;
   /// False when spring dampers barely act on the slowest mode (it moves across the springs), so no
@@ -100,6 +105,6 @@ struct DampingFit {
   bool reachable = true;
 };
 DampingFit fit_damping(const massspring::MassSpringModel& model, const Eigen::VectorXd& x,
-                       double target);
+                       double target, const Eigen::VectorXd& shape = Eigen::VectorXd());
 
 }  // namespace msfem::compare

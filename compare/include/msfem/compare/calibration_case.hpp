@@ -43,6 +43,8 @@ struct CaseCalibration {
   std::vector<LoadReference> train, test;
   CalibrationFit fit;
   DampingFit damping;
+  LoadErrors
+      nonlinear_check;  ///< the calibrated case re-solved (Newton) on the first training load
   double lumped_mass_kg = 0.0, fem_mass_kg = 0.0;
   std::vector<VariantOnTest> variants;  ///< sorted, best (lowest held-out rel_l2_error) first
   int fem_solves = 0, fem_from_cache = 0;

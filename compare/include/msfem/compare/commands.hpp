@@ -17,7 +17,7 @@ int run_command(const Arguments& args);        // msfem run CASE.prm [--out DIR]
 int params_command(const Arguments& args);     // msfem params
 int sweep_command(const Arguments& args);      // msfem sweep CASE.prm [--resolutions ...]
 int bench_command(const Arguments& args);      // msfem bench massspring|fem [--json]
-int verify_command(const Arguments& args);   // msfem verify [--json]
+int verify_command(const Arguments& args);     // msfem verify [--json]
 int regress_command(const Arguments& args);  // msfem regress [--baselines DIR] [CASE...] [--update]
 int calibrate_command(const Arguments& args);  // msfem calibrate CASE.prm [--variant V] [--fit G]
 

@@ -1,0 +1,84 @@
+#include "linearised_statics.hpp"
+
+#include <stdexcept>
+
+namespace msfem::compare {
+
+namespace ms = msfem::massspring;
+
+LinearisedStatics::LinearisedStatics(const ms::MassSpringModel& model,
+                                     const std::vector<Eigen::VectorXd>& parts)
+    : model_(model) {
+  const int n = model.num_dofs();
+  const Eigen::VectorXd rest = model.rest_state();
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    ms::MassSpringModel part = model;
+    part.set_stiffness(parts[p]);
+    if (p > 0 && part.network().num_anchors() > 0) part.set_anchor_parameters(0.0, 0.0);
+    ms::Triplets t;
+    part.add_dfdx_triplets(rest, Eigen::VectorXd::Zero(n), t, ms::Linearisation::exact);
+    Eigen::SparseMatrix<double> j(n, n);
+    j.setFromTriplets(t.begin(), t.end());
+    jacobians_.push_back(j);
+  }
+  std::vector<Eigen::Triplet<double>> s;
+  prescribed_ = Eigen::VectorXd::Zero(n);
+  for (int i = 0, row = 0; i < model.num_nodes(); ++i) {
+    if (model.is_constrained(i)) {
+      prescribed_.segment<3>(3 * i) = model.constrained_target(i) - rest.segment<3>(3 * i);
+      continue;
+    }
+    for (int c = 0; c < 3; ++c)
+      s.emplace_back(row++, 3 * i + c, 1.0);
+  }
+  select_.resize(static_cast<Eigen::Index>(s.size()), n);
+  select_.setFromTriplets(s.begin(), s.end());
+  // Springs exert nothing at rest: what is left is gravity and the external forces.
+  rest_force_ = model.force(rest, Eigen::VectorXd::Zero(n));
+  // Restricted once, so that a new set of weights costs sums and one factorisation.
+  for (const auto& j : jacobians_) {
+    free_stiffness_.push_back(-(select_ * j * select_.transpose()));
+    free_load_.push_back(select_ * (j * prescribed_));
+  }
+}
+
+LinearisedStatics::Solution LinearisedStatics::solve(const std::vector<double>& weights,
+                                                     const std::vector<int>& patch) {
+  if (weights.size() != jacobians_.size())
+    throw std::invalid_argument("LinearisedStatics: one weight per part is needed");
+  // f(u) = f_rest + J u = 0 on the free dofs, u = prescribed on the others.
+  Eigen::SparseMatrix<double> k = weights[0] * free_stiffness_[0];
+  Eigen::VectorXd rhs = select_ * rest_force_ + weights[0] * free_load_[0];
+  for (std::size_t p = 1; p < jacobians_.size(); ++p) {
+    k += weights[p] * free_stiffness_[p];
+    rhs += weights[p] * free_load_[p];
+  }
+  if (!cholesky_) {
+    cholesky_ = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>>();
+    cholesky_->analyzePattern(k);
+  }
+  cholesky_->factorize(k);
+  if (cholesky_->info() != Eigen::Success)
+    throw std::runtime_error(
+        "the spring model linearised at rest is not positive definite (a mechanism that only "
+        "the deformed state stiffens): use calibration/model = nonlinear");
+  const Eigen::VectorXd u = prescribed_ + select_.transpose() * cholesky_->solve(rhs);
+  if (!u.allFinite()) throw std::runtime_error("linearised statics: non-finite displacement");
+  Solution s;
+  const auto& surface = model_.network().surface_nodes;
+  s.surface_displacement.resize(static_cast<Eigen::Index>(surface.size()), 3);
+  for (std::size_t v = 0; v < surface.size(); ++v)
+    s.surface_displacement.row(static_cast<Eigen::Index>(v)) =
+        u.segment<3>(3 * surface[v]).transpose();
+  // Only the patch rows of J u are needed: J is symmetric, so row i of J is column i.
+  for (int node : patch)
+    for (int c = 0; c < 3; ++c) {
+      double f = rest_force_[3 * node + c];
+      for (std::size_t p = 0; p < jacobians_.size(); ++p)
+        f += weights[p] * jacobians_[p].col(3 * node + c).dot(u);
+      s.patch_force[c] += f;
+    }
+  return s;
+}
+
+}  // namespace msfem::compare
