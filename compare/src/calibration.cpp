@@ -136,6 +136,14 @@ LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
   return errors_against(reference, s.surface_displacement, s.tool_force);
 }
 
+LoadErrors evaluate_load_linear(BuiltVariant& variant, const Problem& problem,
+                                const LoadReference& reference) {
+  set_tool_depth(variant, problem, reference.tool);
+  LinearisedStatics statics(*variant.model, {variant.model->network().stiffness});
+  const auto s = statics.solve({1.0}, variant.tool_patch);
+  return errors_against(reference, s.surface_displacement, s.patch_force);
+}
+
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
                          const std::string& variant_name, const std::vector<LoadReference>& train,
                          const std::vector<LoadReference>& test,

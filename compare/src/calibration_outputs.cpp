@@ -123,8 +123,9 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
      << ")"
      << (std::abs(c.lumped_mass_kg / c.fem_mass_kg - 1) > 0.02 ? ": they differ" : ": they match")
      << "\n\n";
-  md << "## Variants on the held-out loads\n\n| variant | mean rel L2 | mean force err "
-        "|\n|---|---|---|\n";
+  md << "## Variants on the held-out loads\n\n"
+     << (c.options.linear ? "All solved linearised at rest, as the fit was.\n\n" : "")
+     << "| variant | mean rel L2 | mean force err |\n|---|---|---|\n";
   for (const auto& v : c.variants)
     md << "| " << v.name << (v.calibrated ? " (calibrated)" : " (as the case has it)") << " | "
        << fmt("%.4f", v.mean_rel_l2_error) << " | " << fmt("%.4f", v.mean_reaction_force_rel_error)
@@ -163,6 +164,8 @@ nlohmann::json calibration_json(const CaseCalibration& c) {
              "mean over training loads of rel_l2_error^2 + "
              "force_weight * reaction_force_rel_error^2"},
             {"force_weight", c.options.force_weight}}},
+          {"model", c.options.linear ? "linear" : "nonlinear"},
+          {"nonlinear_check", errors_json({c.nonlinear_check}).at(0)},
           {"optimiser",
            {{"method", "NLopt BOBYQA on log(k / k_start)"},
             {"evaluations", c.fit.evaluations},

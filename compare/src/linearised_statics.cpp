@@ -64,6 +64,14 @@ LinearisedStatics::Solution LinearisedStatics::solve(const std::vector<double>& 
         "the deformed state stiffens): use calibration/model = nonlinear");
   const Eigen::VectorXd u = prescribed_ + select_.transpose() * cholesky_->solve(rhs);
   if (!u.allFinite()) throw std::runtime_error("linearised statics: non-finite displacement");
+  // A mechanism the factorisation let through (pivots tiny but positive) shows as free nodes moving
+  // far more than anything pushes them.
+  const double pushed = prescribed_.cwiseAbs().maxCoeff();
+  if (pushed > 0 && u.cwiseAbs().maxCoeff() > 100.0 * pushed)
+    throw std::runtime_error(
+        "the spring model linearised at rest has a mechanism (free nodes move " +
+        std::to_string(u.cwiseAbs().maxCoeff() / pushed) +
+        " times the prescribed displacement): it needs the deformed state to stiffen it");
   Solution s;
   const auto& surface = model_.network().surface_nodes;
   s.surface_displacement.resize(static_cast<Eigen::Index>(surface.size()), 3);

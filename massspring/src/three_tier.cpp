@@ -131,8 +131,10 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   const double shell23 = std::max(volume2 - volume3, 0.0);
   const double rho = options.material.density;
   const double total_mass = rho * volume1;
+  // Tier 3 takes what is left of ρV, so the total is the body's mass even where folded inner tiers
+  // make the enclosed volumes inconsistent (the brain's offset tier 3 encloses more than tier 2).
   const double tier_mass[3] = {rho * 0.5 * shell12, rho * 0.5 * (shell12 + shell23),
-                               rho * (0.5 * shell23 + volume3)};
+                               std::max(total_mass - rho * (shell12 + 0.5 * shell23), 0.0)};
   const Eigen::MatrixX3d* tiers[3] = {&vertices, &tier2, &tier3};
   const double floor_mass =
       1e-6 * total_mass / (3.0 * nv);  // keeps masses > 0 if a shell collapses

@@ -109,6 +109,9 @@ TEST(ThreeTier, FoldedInnerTierKeepsItsShellStiffness) {
   const Eigen::VectorXd lengths = Eigen::VectorXd::Constant(642, 0.075);
   const double expected = isotropic_network_stiffness(3000.0, prisms, lengths)[0];
   EXPECT_NEAR(sum / count / expected, 1.0, 0.03);
+  // The lumped mass stays the body's, ρV, although tier 3 encloses an inconsistent volume.
+  const double body = 1040.0 * std::abs(enclosed_volume(mesh.vertices, mesh.triangles));
+  EXPECT_NEAR(network.masses.sum() / body, 1.0, 1e-9);
 }
 
 TEST(SingleLayer, SurfaceEdgesAndAnchors) {

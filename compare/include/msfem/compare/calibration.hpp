@@ -90,6 +90,11 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
 LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
                          const LoadReference& reference, Eigen::VectorXd& x);
 
+/// The same on the model linearised at rest (one Cholesky factorisation); throws
+/// std::runtime_error where that stiffness is singular.
+LoadErrors evaluate_load_linear(BuiltVariant& variant, const Problem& problem,
+                                const LoadReference& reference);
+
 /// The damping ratio of the case's per-spring damping ("mass spring/damping ratio") that gives a
 /// mode of the loaded model the modal damping ratio `target` (springs damp along their axis with d
 /// = 2 r sqrt(k m_a m_b/(m_a+m_b)), so the modal ratio is linear in r). The mode is `shape` (a
