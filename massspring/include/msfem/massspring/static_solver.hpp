@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "msfem/massspring/mass_spring_model.hpp"
 
@@ -14,10 +15,35 @@ enum class StaticLinearSolver {
 struct StaticOptions {
   StaticLinearSolver linear_solver = StaticLinearSolver::sparse_ldlt;
   int max_iterations = 100;
-  /// Converged when |f_free| <= tolerance × max(|applied loads|, |f_free at start|).
+  /// Converged when |f_free| <= tolerance × max(|applied loads|, |f_free at the initial state|),
+  /// or when the Newton step no longer moves any free coordinate beyond its round-off.
   double tolerance = 1e-11;
   double cg_tolerance = 1e-12;
   int cg_max_iterations = 5000;
+  /// sparse_ldlt: solve each Newton system first by conjugate gradients preconditioned with the
+  /// last factorisation, and factorise again only when that fails (K indefinite) or needs more
+  /// than `max_preconditioned_iterations`. A factorisation of the brain costs about as much as
+  /// a hundred preconditioned iterations. Off: one factorisation per Newton iteration.
+  bool reuse_factorization = true;
+  int max_preconditioned_iterations = 30;
+};
+
+/// How one Newton direction was found.
+enum class StaticStep {
+  exact_factorized,         ///< LDLT of the exact tangent
+  exact_preconditioned,     ///< CG on the exact tangent, preconditioned by an earlier LDLT
+  definite_factorized,      ///< LDLT of the definite linearisation (exact one not definite)
+  definite_preconditioned,  ///< CG on the definite linearisation, preconditioned
+  shifted,                  ///< LDLT of the definite linearisation + μM (mechanisms)
+  jacobi_cg                 ///< StaticLinearSolver::cg
+};
+
+struct StaticIteration {
+  double residual_norm = 0.0;  ///< |f_free| after the step, N
+  double step_length = 1.0;    ///< line-search α
+  StaticStep step = StaticStep::exact_factorized;
+  double shift = 0.0;               ///< μ when step == shifted
+  int preconditioned_iterations = 0;  ///< CG iterations spent on this direction (all attempts)
 };
 
 struct StaticResult {
@@ -26,14 +52,22 @@ struct StaticResult {
   double residual_norm = 0.0;   ///< |f| on free dofs, N
   double reference_norm = 0.0;  ///< the scale the tolerance multiplies
   bool converged = false;
+  /// Converged because the Newton step fell below the resolution of doubles at x while |f| was
+  /// still above the tolerance: |f| is then at its round-off floor (cancellation in the spring
+  /// forces), which on the brain lies near 1e-11 × the reference.
+  bool converged_at_roundoff = false;
+  int factorizations = 0;              ///< LDLT factorisations, the dominant cost
+  int preconditioned_iterations = 0;   ///< CG iterations with a reused factorisation
+  std::vector<StaticIteration> history;  ///< one entry per Newton iteration
 };
 
 /// Static equilibrium f(x) = 0 on the free dofs (constrained nodes at their targets, tool contact
 /// included) by Newton's method with a backtracking (Armijo) line search on the potential energy.
 /// The exact tangent is tried first; if it is not positive definite (compressed springs, buckling)
 /// the definite linearisation is used for that iteration. Starts from `start` when it has the right
-/// size, else from the initial state. Throws ModelError if the free dofs are unsupported (singular
-/// stiffness: add supports or anchors).
+/// size, else from the initial state; the tolerance does not depend on the start, so a warm start
+/// from an equilibrium returns at once. Throws ModelError if the free dofs are unsupported
+/// (singular stiffness: add supports or anchors).
 StaticResult solve_static(const MassSpringModel& model, const StaticOptions& options = {},
                           const Eigen::VectorXd& start = Eigen::VectorXd());
 

@@ -1,0 +1,124 @@
+#include "node_relaxation.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+namespace msfem::massspring::detail {
+namespace {
+
+// CSR lists of items per node from an item -> node(s) map.
+template <typename NodesOf>
+void bucket(int num_nodes, int num_items, int per_item, NodesOf nodes_of, std::vector<int>& start,
+            std::vector<int>& items) {
+  start.assign(num_nodes + 1, 0);
+  for (int s = 0; s < num_items; ++s)
+    for (int e = 0; e < per_item; ++e)
+      ++start[nodes_of(s, e) + 1];
+  for (int i = 0; i < num_nodes; ++i)
+    start[i + 1] += start[i];
+  items.resize(start.back());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (int s = 0; s < num_items; ++s)
+    for (int e = 0; e < per_item; ++e)
+      items[fill[nodes_of(s, e)]++] = s;
+}
+
+}  // namespace
+
+NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
+  const SpringNetwork& net = model.network();
+  bucket(
+      net.num_nodes(), net.num_springs(), 2, [&](int s, int e) { return net.springs(s, e); },
+      spring_start_, springs_);
+  bucket(
+      net.num_nodes(), net.num_anchors(), 1, [&](int a, int) { return net.anchor_node[a]; },
+      anchor_start_, anchors_);
+  in_contact_set_.assign(net.num_nodes(), 0);
+  if (model.contact())
+    for (int i : model.contact()->nodes())
+      in_contact_set_[i] = 1;
+}
+
+double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vector3d& p,
+                             Eigen::Vector3d* force, Eigen::Matrix3d* stiffness) const {
+  const SpringNetwork& net = model_.network();
+  const Eigen::Vector3d load =
+      net.masses[i] * model_.gravity() + model_.external_forces().row(i).transpose();
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  double energy = -load.dot(p);
+  Eigen::Vector3d f = load;
+  Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+  for (int q = spring_start_[i]; q < spring_start_[i + 1]; ++q) {
+    const int s = springs_[q];
+    const int j = net.springs(s, 0) == i ? net.springs(s, 1) : net.springs(s, 0);
+    const Eigen::Vector3d d = x.segment<3>(3 * j) - p;
+    const double length = d.norm();
+    const double stretch = length - net.rest_length[s];
+    energy += 0.5 * net.stiffness[s] * stretch * stretch;
+    if (!(length > 0.0)) continue;
+    const Eigen::Vector3d n = d / length;
+    f += net.stiffness[s] * stretch * n;
+    // Compressed springs' negative transverse term dropped: the 3x3 stays definite.
+    const Eigen::Matrix3d nn = n * n.transpose();
+    k += net.stiffness[s] * (nn + std::max(stretch / length, 0.0) * (identity - nn));
+  }
+  for (int q = anchor_start_[i]; q < anchor_start_[i + 1]; ++q) {
+    const int a = anchors_[q];
+    const Eigen::Vector3d d = p - net.anchor_point.row(a).transpose();
+    energy += 0.5 * net.anchor_stiffness[a] * d.squaredNorm();
+    f -= net.anchor_stiffness[a] * d;
+    k += net.anchor_stiffness[a] * identity;
+  }
+  if (in_contact_set_[i]) {
+    const SphereContactForceField& contact = *model_.contact();
+    const Eigen::Vector3d w = p - contact.tool().center;
+    const double rho = w.norm();
+    const double gap = contact.tool().radius - rho;
+    if (gap > 0.0 && rho > 0.0) {
+      energy += 0.5 * contact.penalty_stiffness() * gap * gap;
+      f += contact.penalty_stiffness() * gap / rho * w;
+      k += contact.penalty_stiffness() * (w / rho) * (w / rho).transpose();
+    }
+  }
+  if (force) *force = f;
+  if (stiffness) *stiffness = k;
+  return energy;
+}
+
+void NodeRelaxation::relax_node(Eigen::VectorXd& x, int i) const {
+  for (int newton = 0; newton < 5; ++newton) {
+    const Eigen::Vector3d p = x.segment<3>(3 * i);
+    Eigen::Vector3d f;
+    Eigen::Matrix3d k;
+    const double energy = local(x, i, p, &f, &k);
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(k);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) return;
+    const Eigen::Vector3d step = ldlt.solve(f);
+    if (!step.allFinite() || !(step.dot(f) > 0.0)) return;
+    double alpha = 1.0;
+    for (; alpha > 1e-6; alpha *= 0.5)
+      if (local(x, i, p + alpha * step, nullptr, nullptr) < energy) break;
+    if (!(alpha > 1e-6)) return;
+    x.segment<3>(3 * i) = p + alpha * step;
+    if (alpha * step.norm() <= 1e-14 * p.norm()) return;
+  }
+}
+
+int NodeRelaxation::relax(Eigen::VectorXd& x, const Eigen::VectorXd& f, double fraction,
+                          int sweeps) const {
+  double largest = 0.0;
+  for (int i = 0; i < model_.num_nodes(); ++i)
+    largest = std::max(largest, f.segment<3>(3 * i).norm());
+  std::vector<int> nodes;
+  for (int i = 0; i < model_.num_nodes(); ++i)
+    if (!model_.is_constrained(i) && largest > 0.0 &&
+        f.segment<3>(3 * i).norm() >= fraction * largest)
+      nodes.push_back(i);
+  for (int sweep = 0; sweep < sweeps; ++sweep)
+    for (int i : nodes)
+      relax_node(x, i);
+  return static_cast<int>(nodes.size());
+}
+
+}  // namespace msfem::massspring::detail
