@@ -27,13 +27,6 @@ std::vector<std::string> split_groups(const std::string& text) {
   return groups;
 }
 
-std::string timestamp() {
-  const std::time_t now = std::time(nullptr);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
-  return text;
-}
-
 }  // namespace
 
 int calibrate_command(const Arguments& args) {
@@ -60,10 +53,10 @@ int calibrate_command(const Arguments& args) {
   if (!opt.flag("no-cache"))
     request.fem_cache_directory = std::filesystem::path(parameters.output.directory) / ".fem-cache";
 
-  const std::filesystem::path final_dir = opt.value("out")
-                                              ? std::filesystem::path(*opt.value("out"))
-                                              : std::filesystem::path(parameters.output.directory) /
-                                                    (parameters.name + "-calibrate-" + timestamp());
+  const std::filesystem::path final_dir =
+      opt.value("out") ? std::filesystem::path(*opt.value("out"))
+                       : std::filesystem::path(parameters.output.directory) /
+                             (parameters.name + "-calibrate-" + run_timestamp());
   std::ostringstream printed;
   bool converged = true;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {

@@ -14,17 +14,6 @@
 #include "msfem/compare/run_outputs.hpp"
 
 namespace msfem::compare {
-namespace {
-
-std::string timestamp() {
-  const std::time_t now = std::time(nullptr);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
-  return text;
-}
-
-}  // namespace
-
 int run_command(const Arguments& args) {
   const Options opt(args, {"quiet", "json", "no-curve", "no-timing", "no-cache"}, {"out", "set"});
   if (opt.positional().size() != 1)
@@ -35,7 +24,7 @@ int run_command(const Arguments& args) {
   const std::filesystem::path final_dir = opt.value("out")
                                               ? std::filesystem::path(*opt.value("out"))
                                               : std::filesystem::path(parameters.output.directory) /
-                                                    (parameters.name + "-" + timestamp());
+                                                    (parameters.name + "-" + run_timestamp());
   std::ostringstream printed;  // shown once the folder is in place
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
     RunSettings settings;

@@ -56,13 +56,10 @@ int sweep_command(const Arguments& args) {
         name != "rk4" && name != "implicit_euler")
       throw std::invalid_argument("option --integrators: unknown integrator '" + name + "'");
 
-  char stamp[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
   const std::filesystem::path final_dir = opt.value("out")
                                               ? std::filesystem::path(*opt.value("out"))
                                               : std::filesystem::path(parameters.output.directory) /
-                                                    (parameters.name + "-sweep-" + stamp);
+                                                    (parameters.name + "-sweep-" + run_timestamp());
   std::ostringstream printed;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work) {
     const auto points = run_sweep(

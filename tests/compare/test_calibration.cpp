@@ -27,11 +27,11 @@ cases::CaseParameters sphere_case() {
   return p;
 }
 
-// "FEM" data: the three-tier model with the given group scales, solved on each tool.
-std::vector<LoadReference> synthetic_references(const Problem& truth) {
+// "FEM" data: the three-tier model with the given group scales, solved on each tool at its depth.
+std::vector<LoadReference> synthetic_references(const Problem& truth, std::vector<double> depths = {
+                                                                          0.004, 0.003, 0.0035}) {
   std::vector<LoadReference> refs;
   const fem_reference::VolumeMesh no_mesh;
-  const double depths[] = {0.004, 0.003, 0.0035};
   for (std::size_t i = 0; i < truth.tools.size(); ++i) {
     LoadReference r;
     r.load = {truth.parameters.loads.tool.directions[i], depths[i]};
@@ -199,22 +199,7 @@ TEST(Calibration, LinearisedModelAgreesWithNewtonAtSmallDepth) {
   p.loads.tool.depth_m = 0.00005;
   p.loads.tool.directions = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
   p.mass_spring.group_scales = {{"tier1_edges", 1.5}, {"tier12_radial", 0.6}};
-  const Problem truth = make_problem(p);
-  std::vector<LoadReference> refs;
-  for (std::size_t i = 0; i < truth.tools.size(); ++i) {
-    LoadReference r;
-    r.load = {truth.parameters.loads.tool.directions[i], 0.00005};
-    r.tool = truth.tools[i];
-    BuiltVariant v = build_variant("three_tier", truth, {}, r.tool);
-    const StaticSolution s = solve_variant_static(v);
-    r.surface_displacement = s.surface_displacement;
-    r.tool_force = s.tool_force;
-    for (Eigen::Index vertex = 0; vertex < truth.surface.num_vertices(); ++vertex)
-      if (std::find(v.tool_patch.begin(), v.tool_patch.end(), vertex) == v.tool_patch.end() &&
-          !truth.fixed_region(truth.surface.vertices.row(vertex).transpose()))
-        r.compared_vertices.push_back(static_cast<int>(vertex));
-    refs.push_back(r);
-  }
+  const std::vector<LoadReference> refs = synthetic_references(make_problem(p), {5e-5, 5e-5});
   p.mass_spring.group_scales.clear();
   const Problem problem = make_problem(p);
   CalibrationOptions options;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <ctime>
 #include <map>
 #include <optional>
 #include <set>
@@ -10,6 +11,14 @@
 #include "msfem/compare/commands.hpp"
 
 namespace msfem::compare {
+
+/// Local time as YYYYmmdd-HHMMSS: the suffix of a run's default output folder.
+inline std::string run_timestamp() {
+  const std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return text;
+}
 
 /// Command-line options of one sub-command: `--flag`, `--key value` or `--key=value`, and
 /// positional arguments. Anything not declared is an error naming the option, so a typo never goes
