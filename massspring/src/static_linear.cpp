@@ -28,46 +28,10 @@ void FreeDofs::scatter_add(const Eigen::VectorXd& free, double scale, Eigen::Vec
     full[full_index[k]] += scale * free[k];
 }
 
-Eigen::VectorXd tension_correction(const SpringNetwork& net, const Eigen::VectorXd& x,
-                                   const Eigen::VectorXd& tension, Linearisation mode) {
-  Eigen::VectorXd c = Eigen::VectorXd::Zero(net.num_springs());
-  for (int s = 0; s < net.num_springs(); ++s) {
-    const double l = (x.segment<3>(3 * net.springs(s, 1)) - x.segment<3>(3 * net.springs(s, 0))).norm();
-    if (!(l > 0.0)) continue;
-    double model_tension = net.stiffness[s] * (l - net.rest_length[s]);
-    double carried = tension[s];
-    if (mode == Linearisation::definite) {
-      model_tension = std::max(model_tension, 0.0);
-      carried = std::max(carried, 0.0);
-    }
-    c[s] = (carried - model_tension) / l;
-  }
-  return c;
-}
-
 Eigen::SparseMatrix<double> free_stiffness(const MassSpringModel& model, const Eigen::VectorXd& x,
-                                           const FreeDofs& dofs, Linearisation mode,
-                                           const Eigen::VectorXd* tension) {
+                                           const FreeDofs& dofs, Linearisation mode) {
   Triplets all;
   model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), all, mode);
-  if (tension) {
-    const SpringNetwork& net = model.network();
-    const Eigen::VectorXd c = tension_correction(net, x, *tension, mode);
-    for (int s = 0; s < net.num_springs(); ++s) {
-      if (c[s] == 0.0) continue;
-      const int i = net.springs(s, 0), j = net.springs(s, 1);
-      const Eigen::Vector3d n = (x.segment<3>(3 * j) - x.segment<3>(3 * i)).normalized();
-      // ∂f/∂x blocks: +B at (i,j), (j,i); -B at (i,i), (j,j).
-      const Eigen::Matrix3d b = c[s] * (Eigen::Matrix3d::Identity() - n * n.transpose());
-      for (int r = 0; r < 3; ++r)
-        for (int q = 0; q < 3; ++q) {
-          all.emplace_back(3 * i + r, 3 * j + q, b(r, q));
-          all.emplace_back(3 * j + r, 3 * i + q, b(r, q));
-          all.emplace_back(3 * i + r, 3 * i + q, -b(r, q));
-          all.emplace_back(3 * j + r, 3 * j + q, -b(r, q));
-        }
-    }
-  }
   Triplets free;
   free.reserve(all.size() + 3 * dofs.size());
   for (const auto& t : all) {
@@ -86,13 +50,11 @@ Eigen::SparseMatrix<double> free_stiffness(const MassSpringModel& model, const E
 }
 
 TangentOperator::TangentOperator(const MassSpringModel& model, const FreeDofs& dofs,
-                                 const Eigen::VectorXd& x, Linearisation mode,
-                                 const Eigen::VectorXd* tension)
+                                 const Eigen::VectorXd& x, Linearisation mode)
     : model_(model),
       dofs_(dofs),
       x_(x),
       mode_(mode),
-      tension_(tension),
       full_dx_(Eigen::VectorXd::Zero(x.size())),
       full_df_(x.size()) {}
 
@@ -102,19 +64,6 @@ Eigen::VectorXd TangentOperator::operator*(const Eigen::VectorXd& v) const {
   full_df_.setZero();
   // Velocities are zero in statics, so the damping terms of ∂f/∂x vanish.
   model_.add_dfdx_product(x_, Eigen::VectorXd::Zero(x_.size()), full_dx_, full_df_, mode_);
-  if (tension_) {
-    if (correction_.size() == 0) correction_ = tension_correction(model_.network(), x_, *tension_, mode_);
-    const SpringNetwork& net = model_.network();
-    for (int s = 0; s < net.num_springs(); ++s) {
-      if (correction_[s] == 0.0) continue;
-      const int i = net.springs(s, 0), j = net.springs(s, 1);
-      const Eigen::Vector3d n = (x_.segment<3>(3 * j) - x_.segment<3>(3 * i)).normalized();
-      const Eigen::Vector3d w = full_dx_.segment<3>(3 * j) - full_dx_.segment<3>(3 * i);
-      const Eigen::Vector3d change = correction_[s] * (w - n * n.dot(w));
-      full_df_.segment<3>(3 * i) += change;
-      full_df_.segment<3>(3 * j) -= change;
-    }
-  }
   return -dofs_.gather(full_df_);
 }
 

@@ -29,19 +29,13 @@ struct FreeDofs {
 /// block are stored even when zero (a collapsed spring, contact
 /// switched off), so the pattern depends only on the topology and the supports.
 Eigen::SparseMatrix<double> free_stiffness(const MassSpringModel& model, const Eigen::VectorXd& x,
-                                           const FreeDofs& dofs, Linearisation mode,
-                                           const Eigen::VectorXd* tension = nullptr);
-
-/// Per spring: coefficient c of (I - n nᵀ) to add to its tangent block so that its geometric
-/// stiffness uses `tension` instead of k (l - l0).
-Eigen::VectorXd tension_correction(const SpringNetwork& net, const Eigen::VectorXd& x,
-                                   const Eigen::VectorXd& tension, Linearisation mode);
+                                           const FreeDofs& dofs, Linearisation mode);
 
 /// y = K v on the free dofs without assembling K (a few ms on the brain against ~0.2 s assembly).
 class TangentOperator {
  public:
   TangentOperator(const MassSpringModel& model, const FreeDofs& dofs, const Eigen::VectorXd& x,
-                  Linearisation mode, const Eigen::VectorXd* tension = nullptr);
+                  Linearisation mode);
   Eigen::VectorXd operator*(const Eigen::VectorXd& v) const;
 
  private:
@@ -49,8 +43,7 @@ class TangentOperator {
   const FreeDofs& dofs_;
   const Eigen::VectorXd& x_;
   Linearisation mode_;
-  const Eigen::VectorXd* tension_;
-  mutable Eigen::VectorXd full_dx_, full_df_, correction_;
+  mutable Eigen::VectorXd full_dx_, full_df_;
 };
 
 /// SimplicialLDLT whose symbolic analysis (ordering, elimination tree) is done once and kept for

@@ -2,14 +2,12 @@
 
 #include "msfem/massspring/static_solver.hpp"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 #include "msfem/massspring/errors.hpp"
+#include "node_relaxation.hpp"
 #include "static_linear.hpp"
 
 namespace msfem::massspring {
@@ -18,6 +16,11 @@ namespace {
 using detail::FreeDofs;
 using detail::KrylovOutcome;
 using SparseMatrix = Eigen::SparseMatrix<double>;
+
+// Nodal relaxation visits the nodes whose residual force is at least this fraction of the
+// largest, this many times: on the brain these are the few dozen ends of the folded springs.
+constexpr double relaxation_fraction = 0.01;
+constexpr int relaxation_sweeps = 2;
 
 bool solve_jacobi_cg(const SparseMatrix& k, const Eigen::VectorXd& r, Eigen::VectorXd& d,
                      const StaticOptions& options) {
@@ -44,12 +47,15 @@ bool solve_jacobi_cg(const SparseMatrix& k, const Eigen::VectorXd& r, Eigen::Vec
   return d.allFinite() && it < options.cg_max_iterations;
 }
 
-// Finds Newton directions; keeps the last factorisation (and its symbolic analysis) between
+// Finds Newton directions. Keeps the last factorisation (and its symbolic analysis) between
 // iterations, where it preconditions CG on the next tangent.
 class DirectionFinder {
  public:
   DirectionFinder(const MassSpringModel& model, const FreeDofs& dofs, const StaticOptions& options)
-      : model_(model), dofs_(dofs), options_(options), free_mass_(dofs.gather(model.mass_per_dof())) {}
+      : model_(model),
+        dofs_(dofs),
+        options_(options),
+        free_mass_(dofs.gather(model.mass_per_dof())) {}
 
   // d with d·r > 0 (a descent direction for the energy); false if every linearisation is singular.
   bool find(const Eigen::VectorXd& x, const Eigen::VectorXd& r, double linear_tolerance,
@@ -68,7 +74,7 @@ class DirectionFinder {
       exact_indefinite = outcome == KrylovOutcome::negative_curvature;
     }
     if (ldlt && !exact_indefinite) {
-      if (factorized(free_stiffness(model_, x, dofs_, Linearisation::exact, tension_), r, d)) {
+      if (factorized(free_stiffness(model_, x, dofs_, Linearisation::exact), r, d)) {
         record.step = StaticStep::exact_factorized;
         return true;
       }
@@ -83,9 +89,10 @@ class DirectionFinder {
         return true;
       }
     }
-    const SparseMatrix k = free_stiffness(model_, x, dofs_, Linearisation::definite, tension_);
+    const SparseMatrix k = free_stiffness(model_, x, dofs_, Linearisation::definite);
     auto solve = [&](const SparseMatrix& matrix) {
-      return ldlt ? factorized(matrix, r, d) : solve_jacobi_cg(matrix, r, d, options_) && d.dot(r) > 0.0;
+      return ldlt ? factorized(matrix, r, d)
+                  : solve_jacobi_cg(matrix, r, d, options_) && d.dot(r) > 0.0;
     };
     record.step = ldlt ? StaticStep::definite_factorized : StaticStep::jacobi_cg;
     if (shift_ == 0.0 && solve(k)) return true;
@@ -111,9 +118,6 @@ class DirectionFinder {
   }
 
   int factorizations() const { return factor_.factorizations(); }
-  void set_tension(const Eigen::VectorXd* tension) { tension_ = tension; }
-  bool has_factor() const { return factor_.valid(); }
-  Eigen::VectorXd factor_solve(const Eigen::VectorXd& r) const { return factor_.solve(r); }
 
  private:
   bool factorized(const SparseMatrix& k, const Eigen::VectorXd& r, Eigen::VectorXd& d) {
@@ -125,11 +129,11 @@ class DirectionFinder {
   KrylovOutcome preconditioned(const Eigen::VectorXd& x, Linearisation mode,
                                const Eigen::VectorXd& r, double tolerance, Eigen::VectorXd& d,
                                StaticIteration& record) {
-    const detail::TangentOperator k(model_, dofs_, x, mode, tension_);
+    const detail::TangentOperator k(model_, dofs_, x, mode);
     int iterations = 0;
-    const KrylovOutcome outcome = detail::preconditioned_cg(
-        [&](const Eigen::VectorXd& v) { return k * v; }, factor_, r, tolerance,
-        options_.max_preconditioned_iterations, d, iterations);
+    const KrylovOutcome outcome =
+        detail::preconditioned_cg([&](const Eigen::VectorXd& v) { return k * v; }, factor_, r,
+                                  tolerance, options_.max_preconditioned_iterations, d, iterations);
     record.preconditioned_iterations += iterations;
     return outcome;
   }
@@ -140,42 +144,24 @@ class DirectionFinder {
   const Eigen::VectorXd free_mass_;
   detail::TangentFactor factor_;
   double shift_ = 0.0;  // last μ that made the shifted tangent positive definite
-  const Eigen::VectorXd* tension_ = nullptr;
 };
-
-// |f_free| of the applied loads (gravity, external forces) and of the initial state, whose
-// larger is the scale of the problem: neither depends on where Newton starts.
-double reference_norm(const MassSpringModel& model, const FreeDofs& dofs) {
-  double load_norm_squared = 0.0;
-  for (int i = 0; i < model.num_nodes(); ++i)
-    if (!model.is_constrained(i))
-      load_norm_squared += (model.network().masses[i] * model.gravity() +
-                            model.external_forces().row(i).transpose())
-                               .squaredNorm();
-  const Eigen::VectorXd x0 = model.initial_state();
-  const double initial = dofs.gather(model.force(x0, Eigen::VectorXd::Zero(x0.size()))).norm();
-  return std::max(std::sqrt(load_norm_squared), initial);
-}
-
 
 struct LineSearchResult {
   double alpha = 1.0;
-  Eigen::VectorXd x, r;
-  int evaluations = 0;
+  Eigen::VectorXd x, f;  // state and full force at x + αd
 };
 
 // Line search on U(x + αd), whose slope is -f(x + αd)·d: sufficient decrease (Armijo) and a
-// strong-Wolfe curvature test |U'(α)| <= c2 |U'(0)|, reached by backtracking when the step is too
-// long and by secant extrapolation when it is too short. Too short is the common case on the
-// brain: near-mechanisms (a floppy shell, folded tier-2 springs only microns long) make U grow
-// faster than quadratically along the soft modes, where a full Newton step covers a fraction of
-// the way and plain backtracking then crawls at Newton's linear rate.
+// strong-Wolfe curvature test |U'(α)| <= c2 |U'(0)|, reached by interpolation when the step is
+// too long and by secant extrapolation when it is too short. Too short is common on the brain:
+// along its near-mechanisms U stiffens faster than quadratically, a full Newton step covers only
+// part of the way, and plain backtracking never lengthens it.
 LineSearchResult line_search(const MassSpringModel& model, const FreeDofs& dofs,
                              const Eigen::VectorXd& x, const Eigen::VectorXd& r,
-                             const Eigen::VectorXd& d, double target) {
-  static const double c2 = std::getenv("MSFEM_C2") ? std::atof(std::getenv("MSFEM_C2")) : 0.1;
-  static const int max_trials = std::getenv("MSFEM_TRIALS") ? std::atoi(std::getenv("MSFEM_TRIALS")) : 8;
+                             const Eigen::VectorXd& d, double target, bool wolfe) {
   constexpr double c1 = 1e-4;
+  constexpr double c2 = 0.1;
+  constexpr int max_trials = 8;
   struct Point {
     double alpha, energy, slope;
   };
@@ -183,132 +169,79 @@ LineSearchResult line_search(const MassSpringModel& model, const FreeDofs& dofs,
   const double slope0 = -d.dot(r);
   // Near convergence the energy change drowns in round-off; such steps count as decreasing.
   const double noise = 1e-13 * std::abs(energy0) + 1e-300;
-  LineSearchResult out;
-  auto evaluate = [&](double alpha, Eigen::VectorXd& xa, Eigen::VectorXd& ra) {
-    xa = x;
-    dofs.scatter_add(d, alpha, xa);
-    ra = dofs.gather(model.force(xa, Eigen::VectorXd::Zero(xa.size())));
-    ++out.evaluations;
-    return Point{alpha, model.potential_energy(xa), -d.dot(ra)};
+  auto decreases = [&](const Point& p) {
+    return p.energy <= energy0 + c1 * p.alpha * slope0 || std::abs(p.energy - energy0) <= noise;
   };
-  Point lo{0.0, energy0, slope0};
-  Point hi{0.0, 0.0, 0.0};
-  bool have_hi = false, have_best = false;
-  Point previous = lo;
+  LineSearchResult trial;
+  auto evaluate = [&](double alpha) {
+    trial.alpha = alpha;
+    trial.x = x;
+    dofs.scatter_add(d, alpha, trial.x);
+    trial.f = model.force(trial.x, Eigen::VectorXd::Zero(x.size()));
+    return Point{alpha, model.potential_energy(trial.x), -d.dot(dofs.gather(trial.f))};
+  };
   double alpha = 1.0;
-  Eigen::VectorXd xa, ra;
-  for (int trial = 0; trial < max_trials; ++trial) {
-    const Point p = evaluate(alpha, xa, ra);
-    const bool decreased = p.energy <= energy0 + c1 * p.alpha * slope0 || std::abs(p.energy - energy0) <= noise;
-    if (decreased && (p.energy <= lo.energy + noise)) {
-      out.alpha = p.alpha;
-      out.x = xa;
-      out.r = ra;
-      have_best = true;
-      if (std::abs(p.slope) <= c2 * std::abs(slope0) || ra.norm() <= target) return out;
-      if (p.slope > 0.0) {
+  if (wolfe) {
+    Point lo{0.0, energy0, slope0}, previous = lo, hi{};
+    bool have_hi = false, have_best = false;
+    LineSearchResult best;
+    for (int n = 0; n < max_trials; ++n) {
+      const Point p = evaluate(alpha);
+      if (decreases(p) && p.energy <= lo.energy + noise) {
+        best = trial;
+        have_best = true;
+        if (std::abs(p.slope) <= c2 * std::abs(slope0) || dofs.gather(trial.f).norm() <= target)
+          return best;
+        if (p.slope > 0.0) {
+          hi = p;
+          have_hi = true;
+        } else {
+          previous = lo;
+          lo = p;
+        }
+      } else {
         hi = p;
         have_hi = true;
-      } else {
-        previous = lo;
-        lo = p;
       }
-    } else {
-      hi = p;
-      have_hi = true;
-    }
-    const double width = hi.alpha - lo.alpha;
-    if (have_hi) {
+      const double width = hi.alpha - lo.alpha;
       double next;
-      if (hi.slope > 0.0 && hi.energy <= energy0 + noise)  // secant on the slope
-        next = lo.alpha - lo.slope * width / (hi.slope - lo.slope);
-      else  // minimum of the quadratic through lo (value, slope) and hi (value)
-        next = lo.alpha - 0.5 * lo.slope * width * width / (hi.energy - lo.energy - lo.slope * width);
-      if (!std::isfinite(next)) next = lo.alpha + 0.5 * width;
-      alpha = std::clamp(next, lo.alpha + 0.1 * width, hi.alpha - 0.1 * width);
-    } else {
-      // Still descending: extrapolate the slope to zero, at least doubling, at most ×4.
-      const double next = lo.slope > previous.slope
-                              ? lo.alpha - lo.slope * (lo.alpha - previous.alpha) / (lo.slope - previous.slope)
-                              : 4.0 * lo.alpha;
-      alpha = std::clamp(std::isfinite(next) ? next : 4.0 * lo.alpha, 2.0 * lo.alpha, 4.0 * lo.alpha);
+      if (have_hi) {
+        next = hi.slope > 0.0 && hi.energy <= energy0 + noise
+                   ? lo.alpha - lo.slope * width / (hi.slope - lo.slope)  // secant on U'
+                   : lo.alpha - 0.5 * lo.slope * width * width /          // quadratic on U
+                                    (hi.energy - lo.energy - lo.slope * width);
+        if (!std::isfinite(next)) next = lo.alpha + 0.5 * width;
+        alpha = std::clamp(next, lo.alpha + 0.1 * width, hi.alpha - 0.1 * width);
+      } else {
+        // Still descending: extrapolate U' to zero, at least doubling and at most ×4.
+        next = lo.slope > previous.slope
+                   ? lo.alpha - lo.slope * (lo.alpha - previous.alpha) / (lo.slope - previous.slope)
+                   : 4.0 * lo.alpha;
+        alpha =
+            std::clamp(std::isfinite(next) ? next : 4.0 * lo.alpha, 2.0 * lo.alpha, 4.0 * lo.alpha);
+      }
     }
+    if (have_best) return best;
+    alpha = std::min(alpha, 1.0);  // no decrease found yet: go on backtracking from here
   }
-  if (have_best) return out;
-  // No decrease found yet: keep halving, as plain Armijo backtracking would.
-  for (int halving = 0; halving < 40; ++halving) {
-    const Point p = evaluate(alpha, xa, ra);
-    if (p.energy <= energy0 + c1 * p.alpha * slope0 || std::abs(p.energy - energy0) <= noise) break;
-    alpha *= 0.5;
-  }
-  out.alpha = alpha;
-  out.x = xa;
-  out.r = ra;
-  return out;
+  // Armijo backtracking.
+  for (int halving = 0; halving < 40; ++halving, alpha *= 0.5)
+    if (decreases(evaluate(alpha))) break;
+  return trial;
 }
 
-// Nonlinear Gauss-Seidel on single nodes (prototype).
-struct NodeSprings {
-  std::vector<int> start, spring;  // CSR: springs at node
-};
-NodeSprings node_springs(const SpringNetwork& net) {
-  NodeSprings a;
-  a.start.assign(net.num_nodes() + 1, 0);
-  for (int s = 0; s < net.num_springs(); ++s) { ++a.start[net.springs(s, 0) + 1]; ++a.start[net.springs(s, 1) + 1]; }
-  for (int i = 0; i < net.num_nodes(); ++i) a.start[i + 1] += a.start[i];
-  a.spring.resize(a.start.back());
-  std::vector<int> fill(a.start.begin(), a.start.end() - 1);
-  for (int s = 0; s < net.num_springs(); ++s) { a.spring[fill[net.springs(s, 0)]++] = s; a.spring[fill[net.springs(s, 1)]++] = s; }
-  return a;
-}
-// Local energy, force and stiffness of node i's springs (anchors and contact ignored: prototype).
-double node_local(const MassSpringModel& model, const NodeSprings& adj, const Eigen::VectorXd& x, int i,
-                  const Eigen::Vector3d& xi, Eigen::Vector3d* f, Eigen::Matrix3d* h) {
-  const SpringNetwork& net = model.network();
-  const Eigen::Vector3d load = net.masses[i] * model.gravity() + model.external_forces().row(i).transpose();
-  double e = -load.dot(xi);
-  if (f) *f = load;
-  if (h) h->setZero();
-  for (int q = adj.start[i]; q < adj.start[i + 1]; ++q) {
-    const int s = adj.spring[q];
-    const int j = net.springs(s, 0) == i ? net.springs(s, 1) : net.springs(s, 0);
-    const Eigen::Vector3d d = x.segment<3>(3 * j) - xi;
-    const double l = d.norm();
-    const double k = net.stiffness[s], stretch = l - net.rest_length[s];
-    e += 0.5 * k * stretch * stretch;
-    if (!(l > 0.0)) continue;
-    const Eigen::Vector3d n = d / l;
-    if (f) *f += k * stretch * n;
-    if (h) {
-      const Eigen::Matrix3d nn = n * n.transpose();
-      *h += k * (nn + std::max(stretch / l, 0.0) * (Eigen::Matrix3d::Identity() - nn));
-    }
-  }
-  return e;
-}
-int relax_nodes(const MassSpringModel& model, const FreeDofs& dofs, const NodeSprings& adj, Eigen::VectorXd& x, const Eigen::VectorXd& r, double fraction, int sweeps) {
-  if (model.contact()) return 0;
-  std::vector<int> nodes;
-  double rmax = 0;
-  for (int k = 0; k < dofs.size(); k += 3) rmax = std::max(rmax, r.segment<3>(k).norm());
-  for (int k = 0; k < dofs.size(); k += 3) if (r.segment<3>(k).norm() >= fraction * rmax) nodes.push_back(dofs.full_index[k] / 3);
-  for (int sweep = 0; sweep < sweeps; ++sweep)
-    for (int i : nodes) {
-      for (int it = 0; it < 5; ++it) {
-        Eigen::Vector3d xi = x.segment<3>(3 * i), f; Eigen::Matrix3d h;
-        const double e0 = node_local(model, adj, x, i, xi, &f, &h);
-        const Eigen::Vector3d step = h.ldlt().solve(f);
-        if (!step.allFinite() || step.dot(f) <= 0) break;
-        double a = 1.0; bool ok = false;
-        for (int b = 0; b < 20; ++b, a *= 0.5) {
-          if (node_local(model, adj, x, i, xi + a * step, nullptr, nullptr) <= e0) { ok = true; break; }
-        }
-        if (!ok) break;
-        x.segment<3>(3 * i) = xi + a * step;
-        if (a * step.norm() < 1e-15 * xi.norm()) break;
-      }
-    }
-  return static_cast<int>(nodes.size());
+// |f_free| of the applied loads (gravity, external forces) and of the initial state, whose
+// larger is the scale of the problem: neither depends on where Newton starts.
+double reference_norm(const MassSpringModel& model, const FreeDofs& dofs) {
+  double load_norm_squared = 0.0;
+  for (int i = 0; i < model.num_nodes(); ++i)
+    if (!model.is_constrained(i))
+      load_norm_squared +=
+          (model.network().masses[i] * model.gravity() + model.external_forces().row(i).transpose())
+              .squaredNorm();
+  const Eigen::VectorXd x0 = model.initial_state();
+  const double initial = dofs.gather(model.force(x0, Eigen::VectorXd::Zero(x0.size()))).norm();
+  return std::max(std::sqrt(load_norm_squared), initial);
 }
 
 }  // namespace
@@ -324,10 +257,8 @@ StaticResult solve_static(const MassSpringModel& model, const StaticOptions& opt
     result.converged = true;
     return result;
   }
-  auto free_residual = [&](const Eigen::VectorXd& x) {
-    return dofs.gather(model.force(x, Eigen::VectorXd::Zero(x.size())));
-  };
-  Eigen::VectorXd r = free_residual(result.x);
+  Eigen::VectorXd f = model.force(result.x, zero_v);
+  Eigen::VectorXd r = dofs.gather(f);
   result.residual_norm = r.norm();
   result.reference_norm = reference_norm(model, dofs);
   if (!(result.reference_norm > 0.0)) {
@@ -335,37 +266,20 @@ StaticResult solve_static(const MassSpringModel& model, const StaticOptions& opt
     return result;
   }
   const double target = options.tolerance * result.reference_norm;
-  const bool trace = std::getenv("MSFEM_TRACE") != nullptr;
-  const double forcing_power = std::getenv("MSFEM_FORCING") ? std::atof(std::getenv("MSFEM_FORCING")) : 1.0;
 
   DirectionFinder directions(model, dofs, options);
-  static const bool mixed = std::getenv("MSFEM_MIXED") != nullptr;
-  const SpringNetwork& net = model.network();
-  Eigen::VectorXd tension(net.num_springs());
-  for (int s = 0; s < net.num_springs(); ++s)
-    tension[s] = net.stiffness[s] * ((result.x.segment<3>(3 * net.springs(s, 1)) - result.x.segment<3>(3 * net.springs(s, 0))).norm() - net.rest_length[s]);
-  if (mixed) directions.set_tension(&tension);
-  double previous_residual = 0.0, previous_eta = 0.1;
+  const detail::NodeRelaxation relaxation(model);
+  double previous_norm = 0.0, eta = 0.1;
   while (result.residual_norm > target && result.iterations < options.max_iterations) {
     ++result.iterations;
-    // Inexact Newton: the linear residual need only be small against |f| (Eisenstat-Walker), and
-    // never much below the target, to keep Newton's quadratic convergence.
-    const double relative = result.residual_norm / result.reference_norm;
-    static const bool ew = std::getenv("MSFEM_EW") != nullptr;
-    static const double eta_max = std::getenv("MSFEM_ETAMAX") ? std::atof(std::getenv("MSFEM_ETAMAX")) : 0.5;
-    double eta = std::min(0.1, std::pow(relative, forcing_power));
-    if (ew) {
-      if (previous_residual > 0.0) {
-        const double ratio = result.residual_norm / previous_residual;
-        double next = 0.9 * ratio * ratio;
-        if (0.9 * previous_eta * previous_eta > 0.1) next = std::max(next, 0.9 * previous_eta * previous_eta);
-        eta = std::min(next, eta_max);
-      } else {
-        eta = 0.1;
-      }
-      previous_eta = eta;
-      previous_residual = result.residual_norm;
+    // Inexact Newton (Eisenstat-Walker choice 2): solve loosely while |f| falls slowly, tightly
+    // once it falls quadratically; never much below the target.
+    if (previous_norm > 0.0) {
+      const double ratio = result.residual_norm / previous_norm;
+      eta = std::min(0.5,
+                     std::max(0.9 * ratio * ratio, 0.9 * eta * eta > 0.1 ? 0.9 * eta * eta : 0.0));
     }
+    previous_norm = result.residual_norm;
     const double linear_tolerance = std::max(eta * result.residual_norm, 0.1 * target);
     Eigen::VectorXd d;
     StaticIteration record;
@@ -379,56 +293,31 @@ StaticResult solve_static(const MassSpringModel& model, const StaticOptions& opt
     double x_scale = 0.0;
     for (int k : dofs.full_index)
       x_scale = std::max(x_scale, std::abs(result.x[k]));
-    if (trace) { int k; d.cwiseAbs().maxCoeff(&k); int node = dofs.full_index[k] / 3;
-      std::fprintf(stderr, "   |d|inf %.3e node %d at (%.4f %.4f %.4f) |d|2 %.3e\n", d.cwiseAbs().maxCoeff(), node, model.network().rest_positions(node,0), model.network().rest_positions(node,1), model.network().rest_positions(node,2), d.norm()); }
-
-    const LineSearchResult ls = line_search(model, dofs, result.x, r, d, target);
-    if (mixed) {
-      Eigen::VectorXd full_d = Eigen::VectorXd::Zero(result.x.size());
-      dofs.scatter_add(d, 1.0, full_d);
-      for (int s = 0; s < net.num_springs(); ++s) {
-        const int i = net.springs(s, 0), j = net.springs(s, 1);
-        const Eigen::Vector3d e = result.x.segment<3>(3 * j) - result.x.segment<3>(3 * i);
-        const double l = e.norm();
-        if (!(l > 0.0)) continue;
-        const double predicted = net.stiffness[s] * (l - net.rest_length[s] + e.dot(full_d.segment<3>(3 * j) - full_d.segment<3>(3 * i)) / l);
-        tension[s] += ls.alpha * (predicted - tension[s]);
-      }
+    if (d.cwiseAbs().maxCoeff() <= 8.0 * std::numeric_limits<double>::epsilon() * x_scale) {
+      result.converged_at_roundoff = true;
+      record.residual_norm = result.residual_norm;
+      record.step_length = 0.0;
+      result.history.push_back(record);
+      break;
     }
-    const double alpha = ls.alpha;
-    const bool use_soc = false;
-    result.x = ls.x;
-    r = ls.r;
-    static const double relax_fraction = std::getenv("MSFEM_RELAX") ? std::atof(std::getenv("MSFEM_RELAX")) : -1.0;
-    static const int relax_sweeps = std::getenv("MSFEM_SWEEPS") ? std::atoi(std::getenv("MSFEM_SWEEPS")) : 2;
-    if (relax_fraction >= 0.0 && r.norm() > target) {
-      static NodeSprings adj;
-      if (adj.start.empty()) adj = node_springs(net);
-      const int relaxed = relax_nodes(model, dofs, adj, result.x, r, relax_fraction, relax_sweeps);
-      const double before = r.norm();
-      r = free_residual(result.x);
-      if (trace) std::fprintf(stderr, "   relaxed %d nodes: |r| %.3e -> %.3e\n", relaxed, before, r.norm());
+
+    LineSearchResult step =
+        line_search(model, dofs, result.x, r, d, target, options.wolfe_line_search);
+    result.x = std::move(step.x);
+    f = std::move(step.f);
+    r = dofs.gather(f);
+    if (options.relax_nodes && r.norm() > target) {
+      relaxation.relax(result.x, f, relaxation_fraction, relaxation_sweeps);
+      f = model.force(result.x, zero_v);
+      r = dofs.gather(f);
     }
     result.residual_norm = r.norm();
     record.residual_norm = result.residual_norm;
-    record.step_length = alpha;
+    record.step_length = step.alpha;
     result.history.push_back(record);
-    if (std::getenv("MSFEM_DUMP") && std::atoi(std::getenv("MSFEM_DUMP")) == result.iterations) {
-      FILE* fd = std::fopen("/tmp/sdrv/xdump.bin", "wb"); std::fwrite(result.x.data(), 8, result.x.size(), fd); std::fclose(fd); }
-    if (trace) {
-      int kmax; Eigen::VectorXd rn(dofs.size() / 3);
-      for (int q = 0; q < rn.size(); ++q) rn[q] = r.segment<3>(3 * q).norm();
-      rn.maxCoeff(&kmax); const int node = dofs.full_index[3 * kmax] / 3;
-      double stiff = 0; for (int s = 0; s < net.num_springs(); ++s) if (net.springs(s,0) == node || net.springs(s,1) == node) stiff = std::max(stiff, net.stiffness[s]);
-      std::fprintf(stderr, "   max |r_i| %.3e (%.0f%%) node %d kmax %.3g\n", rn[kmax], 100 * rn[kmax] / r.norm(), node, stiff);
-    }
-    if (trace)
-      std::fprintf(stderr, "it %3d |r| %.3e alpha %.3e soc %d step %d shift %.1e pcg %d fact %d\n",
-                   result.iterations, result.residual_norm, alpha, (int)use_soc, static_cast<int>(record.step),
-                   record.shift, record.preconditioned_iterations, directions.factorizations());
   }
   result.factorizations = directions.factorizations();
-  result.converged = result.residual_norm <= target;
+  result.converged = result.residual_norm <= target || result.converged_at_roundoff;
   return result;
 }
 

@@ -20,12 +20,20 @@ struct StaticOptions {
   double tolerance = 1e-11;
   double cg_tolerance = 1e-12;
   int cg_max_iterations = 5000;
+  // The three switches below change the path to the equilibrium, not the equations or the
+  // tolerance; all off is plain damped Newton with one factorisation per iteration.
   /// sparse_ldlt: solve each Newton system first by conjugate gradients preconditioned with the
-  /// last factorisation, and factorise again only when that fails (K indefinite) or needs more
-  /// than `max_preconditioned_iterations`. A factorisation of the brain costs about as much as
-  /// a hundred preconditioned iterations. Off: one factorisation per Newton iteration.
+  /// last factorisation (to the Eisenstat-Walker tolerance), and factorise again only when that
+  /// meets negative curvature or needs more than `max_preconditioned_iterations`. On the brain a
+  /// factorisation costs as much as ~80 preconditioned iterations.
   bool reuse_factorization = true;
   int max_preconditioned_iterations = 30;
+  /// After each Newton step, move the free nodes with the largest residual force one at a time
+  /// to their own energy minimum, the others held (nonlinear Gauss-Seidel; it only lowers the
+  /// energy). Removes the stalls that microns-long stiff springs (folded inner tiers) cause.
+  bool relax_nodes = true;
+  /// Line search that also lengthens too-short steps (strong Wolfe); off: Armijo backtracking.
+  bool wolfe_line_search = true;
 };
 
 /// How one Newton direction was found.
@@ -42,7 +50,7 @@ struct StaticIteration {
   double residual_norm = 0.0;  ///< |f_free| after the step, N
   double step_length = 1.0;    ///< line-search α
   StaticStep step = StaticStep::exact_factorized;
-  double shift = 0.0;               ///< μ when step == shifted
+  double shift = 0.0;                 ///< μ when step == shifted
   int preconditioned_iterations = 0;  ///< CG iterations spent on this direction (all attempts)
 };
 
@@ -56,18 +64,21 @@ struct StaticResult {
   /// still above the tolerance: |f| is then at its round-off floor (cancellation in the spring
   /// forces), which on the brain lies near 1e-11 × the reference.
   bool converged_at_roundoff = false;
-  int factorizations = 0;              ///< LDLT factorisations, the dominant cost
-  int preconditioned_iterations = 0;   ///< CG iterations with a reused factorisation
+  int factorizations = 0;                ///< LDLT factorisations, the dominant cost
+  int preconditioned_iterations = 0;     ///< CG iterations with a reused factorisation
   std::vector<StaticIteration> history;  ///< one entry per Newton iteration
 };
 
 /// Static equilibrium f(x) = 0 on the free dofs (constrained nodes at their targets, tool contact
-/// included) by Newton's method with a backtracking (Armijo) line search on the potential energy.
-/// The exact tangent is tried first; if it is not positive definite (compressed springs, buckling)
-/// the definite linearisation is used for that iteration. Starts from `start` when it has the right
-/// size, else from the initial state; the tolerance does not depend on the start, so a warm start
-/// from an equilibrium returns at once. Throws ModelError if the free dofs are unsupported
-/// (singular stiffness: add supports or anchors).
+/// included) by Newton's method with a line search on the potential energy. The exact tangent is
+/// tried first; if it is not positive definite (compressed springs, buckling) the definite
+/// linearisation is used for that iteration. Starts from `start` when it has the right size, else
+/// from the initial state; the tolerance does not depend on the start, so a warm start from an
+/// equilibrium returns at once. Like any descent method it finds the equilibrium whose basin it
+/// starts in: a network with several (a folded or symmetric one that buckles) may end in another
+/// one than with other options or another start, and an exactly symmetric problem can end on a
+/// symmetric saddle. Throws ModelError if the free dofs are unsupported (singular stiffness: add
+/// supports or anchors).
 StaticResult solve_static(const MassSpringModel& model, const StaticOptions& options = {},
                           const Eigen::VectorXd& start = Eigen::VectorXd());
 
