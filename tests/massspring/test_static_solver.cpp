@@ -114,5 +114,20 @@ TEST(StaticSolverAcceleration, WarmStartAfterAStiffnessChangeMatchesColdStart) {
   EXPECT_LE(warm.iterations, cold.iterations);
 }
 
+TEST(StaticSolverAcceleration, ToleranceBelowRoundOffStopsAtTheFloor) {
+  // |f| cannot fall below the cancellation in the spring forces (~1e-16 × k × |x| per spring):
+  // asked for less, Newton stops once its step no longer moves x, instead of running on.
+  const MassSpringModel model = indented_sphere();
+  const StaticResult usual = solve_static(model);
+  StaticOptions strict;
+  strict.tolerance = 1e-20;
+  const StaticResult floor = solve_static(model, strict);
+  ASSERT_TRUE(usual.converged);
+  EXPECT_TRUE(floor.converged);
+  EXPECT_TRUE(floor.converged_at_roundoff);
+  EXPECT_LE(floor.iterations, usual.iterations + 3);
+  EXPECT_LE((floor.x - usual.x).norm(), 1e-9 * (usual.x - model.initial_state()).norm());
+}
+
 }  // namespace
 }  // namespace msfem::massspring
