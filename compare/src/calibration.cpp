@@ -91,13 +91,15 @@ LoadModels models_for(const BuiltVariant& base, const Problem& problem,
   return m;
 }
 
-std::vector<LoadErrors> evaluate_all(LoadModels& m, const Problem& problem,
-                                     const std::vector<LoadReference>& references,
+std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadReference>& references,
                                      const Eigen::VectorXd& stiffness) {
   std::vector<LoadErrors> errors;
   for (std::size_t i = 0; i < references.size(); ++i) {
     m.variants[i].model->set_stiffness(stiffness);
-    errors.push_back(evaluate_load(m.variants[i], problem, references[i], m.x[i]));
+    // The tool was placed once by models_for(): solve as the model stands.
+    const StaticSolution s = solve_variant_static(m.variants[i], m.x[i]);
+    m.x[i] = s.x;
+    errors.push_back(errors_against(references[i], s.surface_displacement, s.tool_force));
   }
   return errors;
 }
@@ -205,7 +207,7 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   }
   auto evaluate = [&](LoadModels& m, const std::vector<LoadReference>& references,
                       const std::vector<double>& theta) {
-    if (!options.linear) return evaluate_all(m, problem, references, stiffness_at(theta));
+    if (!options.linear) return evaluate_all(m, references, stiffness_at(theta));
     std::vector<double> weights(n + 1, 1.0);
     for (int g = 0; g < n; ++g)
       weights[g + 1] = std::exp(theta[g]);

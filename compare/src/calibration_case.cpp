@@ -10,6 +10,7 @@
 #include "msfem/compare/content_hash.hpp"
 #include "msfem/compare/fem_cache.hpp"
 #include "msfem/compare/fem_run.hpp"
+#include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -87,18 +88,6 @@ std::string load_key(const std::string& problem_key, const cases::ToolLoad& load
   return h.hex();
 }
 
-double mesh_mass(const fem_reference::VolumeMesh& mesh, double density) {
-  double volume = 0;
-  for (Eigen::Index t = 0; t < mesh.num_tetrahedra(); ++t) {
-    const Eigen::Vector3d a = mesh.vertices.row(mesh.tetrahedra(t, 0));
-    const Eigen::Vector3d b = mesh.vertices.row(mesh.tetrahedra(t, 1));
-    const Eigen::Vector3d c = mesh.vertices.row(mesh.tetrahedra(t, 2));
-    const Eigen::Vector3d d = mesh.vertices.row(mesh.tetrahedra(t, 3));
-    volume += std::abs((b - a).cross(c - a).dot(d - a)) / 6.0;
-  }
-  return density * volume;
-}
-
 // The FEM of every load, from the cache where it is there.
 void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& train,
                       const std::vector<cases::ToolLoad>& test, const CalibrationRequest& request,
@@ -151,8 +140,8 @@ void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& tr
 }
 
 // Group scales of the calibrated case: the case's own entries with the fitted groups replaced.
-std::string group_scales_assignment(const cases::CaseParameters& p,
-                                    const std::vector<FittedGroup>& fitted) {
+std::vector<std::pair<std::string, double>> calibrated_group_scales(
+    const cases::CaseParameters& p, const std::vector<FittedGroup>& fitted) {
   std::vector<std::pair<std::string, double>> scales;
   for (const auto& [group, factor] : p.mass_spring.group_scales)
     if (std::none_of(fitted.begin(), fitted.end(),
@@ -160,6 +149,10 @@ std::string group_scales_assignment(const cases::CaseParameters& p,
       scales.emplace_back(group, factor);
   for (const auto& f : fitted)
     scales.emplace_back(f.group, f.case_factor);
+  return scales;
+}
+
+std::string group_scales_assignment(const std::vector<std::pair<std::string, double>>& scales) {
   std::string text = "mass spring/group scales=";
   char buffer[64];
   for (std::size_t i = 0; i < scales.size(); ++i) {
@@ -222,15 +215,11 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   // reproduces the fit, and gives the equilibrium the damping fit linearises about.
   c.calibrated_overrides = request.overrides;
   c.calibrated_overrides.push_back("calibration/variant=" + c.variant);
-  c.calibrated_overrides.push_back(group_scales_assignment(parameters, c.fit.groups));
   Problem calibrated = c.problem;
-  calibrated.parameters.mass_spring.group_scales.clear();
-  for (const auto& f : c.fit.groups)
-    calibrated.parameters.mass_spring.group_scales.emplace_back(f.group, f.case_factor);
-  for (const auto& [group, factor] : parameters.mass_spring.group_scales)
-    if (std::none_of(c.fit.groups.begin(), c.fit.groups.end(),
-                     [&](const FittedGroup& f) { return f.group == group; }))
-      calibrated.parameters.mass_spring.group_scales.emplace_back(group, factor);
+  calibrated.parameters.mass_spring.group_scales =
+      calibrated_group_scales(parameters, c.fit.groups);
+  c.calibrated_overrides.push_back(
+      group_scales_assignment(calibrated.parameters.mass_spring.group_scales));
   BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
   Eigen::VectorXd x;
   const LoadErrors check = evaluate_load(built, calibrated, c.train.front(), x);
@@ -262,7 +251,7 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
     c.calibrated_overrides.push_back(
         "geometry/source=" + std::filesystem::absolute(parameters.geometry.source).string());
   c.lumped_mass_kg = built.model->network().masses.sum();
-  c.fem_mass_kg = mesh_mass(c.mesh, parameters.material.density_kg_per_m3);
+  c.fem_mass_kg = parameters.material.density_kg_per_m3 * fem_reference::volume(c.mesh);
 
   c.variants.push_back(mean_on(c.variant, true, c.fit.after.test));
   if (request.compare_variants && !c.test.empty()) {
