@@ -93,6 +93,10 @@ void register_all() {
                                  name, true, 2)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("explicit_soa_float_1thread/" + name).c_str(), explicit_step,
+                                 name, true, 1)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("naive_aos/" + name).c_str(), naive_step, name)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);

@@ -19,13 +19,15 @@ struct FastStepperOptions {
 /// on the model's springs, dampers, node damping, gravity, external forces and supports (tool
 /// contact is not applied here; use Integrator for that). The model must outlive the stepper.
 ///
-/// Layout: structure of arrays, nodes renumbered by reverse Cuthill-McKee with the constrained
-/// ones last (never updated), springs sorted by their first node so that neighbouring springs touch
-/// neighbouring nodes. Each step is two passes split over a persistent thread team with spin
-/// barriers: (1) each thread takes a contiguous share of the springs and scatters their forces
-/// into its own node-force buffer (no write conflicts); (2) each thread takes a share of the free
-/// nodes, sums the buffers, clears them and updates v and x. The kernels are compiled for baseline
-/// x86-64 and for AVX2+FMA and picked at run time.
+/// Layout: nodes renumbered by reverse Cuthill-McKee with the constrained ones last (never
+/// updated); x and v of a node packed in one record. Each step is node-centric: every free node
+/// gathers its own springs' forces from its neighbours' records of the previous step and writes its
+/// new x and v to a second buffer (double buffering), so a step has no scatter, no force buffers to
+/// sum and one barrier. Springs are stored per node in vector-width chunks (sliced ELLPACK) with
+/// their k, k l0 and c beside the neighbour index. Each spring is evaluated twice, once per end:
+/// more arithmetic for far less memory traffic. Threads take contiguous shares of the chunks on a
+/// persistent team; the kernels are compiled for baseline x86-64 and for AVX2+FMA (float: eight
+/// lanes with register transposes of the records) and picked at run time.
 class FastExplicitStepper {
  public:
   explicit FastExplicitStepper(const MassSpringModel& model,

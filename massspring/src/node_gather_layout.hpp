@@ -1,0 +1,144 @@
+#pragma once
+
+// Node-centric (gather) layout for the explicit stepper (internal), built on SoaLayout's numbering.
+// Free nodes go in chunks of W lanes; a chunk holds, slot by slot, one spring of each of its W
+// nodes (sliced ELLPACK, "SELL-W-σ"): slot j of lane l is node l's j-th neighbour with that
+// spring's k, k l0 and c, stored contiguously so that a vector of W lanes reads them with plain
+// loads. Every spring appears twice (once per free end): twice the arithmetic of a spring loop, but
+// a node computes its own force from the previous step's positions, so no scatter, no per-thread
+// force buffers and one barrier per step.
+//
+// Chunks are padded to their widest node. Sorting nodes by degree inside windows of kSortWindow
+// (reverse Cuthill-McKee order between windows) keeps the padding small and the locality.
+//
+// Node records are kRecord reals per node: x y z vx vy vz and two pad slots, so that a neighbour is
+// one 32-byte (float) or 64-byte (double) line. Two records past the last node: an idle one for
+// the empty lanes of the last chunk, at the origin, and a far one that padding slots point to, so
+// that a padded slot (k = k l0 = c = 0) never sees a zero-length spring.
+
+#include <algorithm>
+#include <cstddef>
+#include <new>
+#include <numeric>
+#include <vector>
+
+#include "soa_layout.hpp"
+
+namespace msfem::massspring::detail {
+
+constexpr int kRecord = 8;
+constexpr int kSortWindow = 64;
+
+// Cache-line aligned array for the node records (the vector loads assume 32-byte alignment).
+template <class Real>
+class AlignedArray {
+ public:
+  explicit AlignedArray(std::size_t size = 0)
+      : data_(new (std::align_val_t(64)) Real[size > 0 ? size : 1]()), size_(size) {}
+  ~AlignedArray() { ::operator delete[](data_, std::align_val_t(64)); }
+  AlignedArray(const AlignedArray&) = delete;
+  AlignedArray& operator=(const AlignedArray&) = delete;
+  Real* data() { return data_; }
+  const Real* data() const { return data_; }
+  std::size_t size() const { return size_; }
+  Real& operator[](std::size_t i) { return data_[i]; }
+  const Real& operator[](std::size_t i) const { return data_[i]; }
+
+ private:
+  Real* data_;
+  std::size_t size_;
+};
+
+template <class Real, int W>
+struct NodeGatherLayout {
+  int num_chunks = 0;
+  int idle_record = 0, far_record = 0;  // num_nodes, num_nodes + 1
+  std::vector<int> lane_node;           // chunk * W + lane -> SoA node (idle_record when empty)
+  std::vector<int> chunk_slot, chunk_width;
+  std::vector<int> neighbour, slot_spring;                   // per slot; slot_spring -1 for padding
+  std::vector<Real> k, k_l0, c;                              // per slot
+  std::vector<Real> inverse_mass, damping, anchor, load[3];  // per lane
+  std::vector<int> chunk_begin;                              // per thread-team member
+
+  NodeGatherLayout(const SoaLayout<Real>& soa, int members) {
+    idle_record = soa.num_nodes;
+    far_record = soa.num_nodes + 1;
+    std::vector<int> free(soa.num_free);
+    std::iota(free.begin(), free.end(), 0);
+    auto degree = [&](int i) { return soa.offset[i + 1] - soa.offset[i]; };
+    for (int w = 0; w < soa.num_free; w += kSortWindow)
+      std::stable_sort(free.begin() + w, free.begin() + std::min(w + kSortWindow, soa.num_free),
+                       [&](int p, int q) { return degree(p) > degree(q); });
+    num_chunks = (soa.num_free + W - 1) / W;
+    lane_node.assign(static_cast<std::size_t>(num_chunks) * W, idle_record);
+    std::copy(free.begin(), free.end(), lane_node.begin());
+    chunk_slot.assign(num_chunks + 1, 0);
+    chunk_width.assign(num_chunks, 0);
+    for (int chunk = 0; chunk < num_chunks; ++chunk) {
+      for (int lane = 0; lane < W; ++lane) {
+        const int i = lane_node[chunk * W + lane];
+        if (i != idle_record) chunk_width[chunk] = std::max(chunk_width[chunk], degree(i));
+      }
+      chunk_slot[chunk + 1] = chunk_slot[chunk] + chunk_width[chunk] * W;
+    }
+    neighbour.assign(chunk_slot.back(), far_record);
+    slot_spring.assign(chunk_slot.back(), -1);
+    for (int chunk = 0; chunk < num_chunks; ++chunk)
+      for (int lane = 0; lane < W; ++lane) {
+        const int i = lane_node[chunk * W + lane];
+        if (i == idle_record) continue;
+        for (int e = soa.offset[i]; e < soa.offset[i + 1]; ++e) {
+          const int slot = chunk_slot[chunk] + (e - soa.offset[i]) * W + lane;
+          const int s = soa.incident[e];
+          neighbour[slot] = soa.a[s] == i ? soa.b[s] : soa.a[s];
+          slot_spring[slot] = s;
+        }
+      }
+    k.assign(chunk_slot.back(), Real(0));
+    k_l0.assign(chunk_slot.back(), Real(0));
+    c.assign(chunk_slot.back(), Real(0));
+    inverse_mass.assign(lane_node.size(), Real(0));
+    damping.assign(lane_node.size(), Real(0));
+    anchor.assign(lane_node.size(), Real(0));
+    for (auto& l : load)
+      l.assign(lane_node.size(), Real(0));
+    load_parameters(soa);
+    partition(members);
+  }
+
+  // Copies the per-spring and per-node constants of the SoA layout into slot and lane order.
+  void load_parameters(const SoaLayout<Real>& soa) {
+    for (std::size_t slot = 0; slot < slot_spring.size(); ++slot) {
+      const int s = slot_spring[slot];
+      if (s < 0) continue;
+      k[slot] = soa.stiffness[s];
+      k_l0[slot] = soa.stiffness_rest[s];
+      c[slot] = soa.damping[s];
+    }
+    for (std::size_t lane = 0; lane < lane_node.size(); ++lane) {
+      const int i = lane_node[lane];
+      if (i == idle_record) continue;
+      inverse_mass[lane] = soa.inverse_mass[i];
+      damping[lane] = soa.node_damping[i];
+      anchor[lane] = soa.anchor_stiffness[i];
+      for (int d = 0; d < 3; ++d)
+        load[d][lane] = soa.load[d][i];
+    }
+  }
+
+  // Contiguous chunk ranges with equal shares of slots plus a per-node cost of about two slots.
+  void partition(int members) {
+    chunk_begin.assign(members + 1, num_chunks);
+    chunk_begin[0] = 0;
+    const long total = static_cast<long>(chunk_slot.back()) + 2L * W * num_chunks;
+    int chunk = 0;
+    for (int m = 1; m < members; ++m) {
+      const long target = total * m / members;
+      while (chunk < num_chunks && chunk_slot[chunk] + 2L * W * chunk < target)
+        ++chunk;
+      chunk_begin[m] = chunk;
+    }
+  }
+};
+
+}  // namespace msfem::massspring::detail
