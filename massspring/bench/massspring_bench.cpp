@@ -43,11 +43,12 @@ void annotate(benchmark::State& state, const MassSpringModel& model, int steps_p
 }
 
 void explicit_step(benchmark::State& state, const std::string& name, bool single_precision,
-                   int threads) {
+                   int threads, bool allow_avx512) {
   const MassSpringModel& model = model_for(name);
   const double dt =
       0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
-  FastExplicitStepper stepper(model, FastStepperOptions{threads, single_precision, true});
+  FastExplicitStepper stepper(model,
+                              FastStepperOptions{threads, single_precision, true, allow_avx512});
   stepper.set_state(perturbed_start(model));
   constexpr int kSteps = 10;
   for (auto _ : state)
@@ -82,19 +83,23 @@ void implicit_step(benchmark::State& state, const std::string& name) {
 void register_all() {
   for (const std::string name : {"seed_sphere", "brain_scale", "brain_10x"}) {
     benchmark::RegisterBenchmark(("explicit_soa_double_2threads/" + name).c_str(), explicit_step,
-                                 name, false, 2)
+                                 name, false, 2, true)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("explicit_soa_double_1thread/" + name).c_str(), explicit_step,
-                                 name, false, 1)
+                                 name, false, 1, true)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("explicit_soa_float_2threads/" + name).c_str(), explicit_step,
-                                 name, true, 2)
+                                 name, true, 2, true)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("explicit_soa_float_1thread/" + name).c_str(), explicit_step,
-                                 name, true, 1)
+                                 name, true, 1, true)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("explicit_soa_float_avx2_2threads/" + name).c_str(),
+                                 explicit_step, name, true, 2, false)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("naive_aos/" + name).c_str(), naive_step, name)

@@ -2,6 +2,7 @@
 
 #include "msfem/massspring/fast_stepper.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <type_traits>
@@ -14,7 +15,7 @@
 
 #if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__)
 #define MSFEM_HAVE_X86_DISPATCH 1
-#include <immintrin.h>
+#include "gather_kernels_x86.hpp"
 #define MSFEM_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
 #define MSFEM_HAVE_X86_DISPATCH 0
@@ -92,118 +93,11 @@ MSFEM_ALWAYS_INLINE double gather_chunks(const NodeGatherLayout<Real, W>& g,
 }
 
 #if MSFEM_HAVE_X86_DISPATCH
-#define MSFEM_TARGET_AVX2 __attribute__((target("avx2,fma")))
 bool cpu_has_avx2() {
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }
-
-// Eight node records (x y z vx | vy vz pad pad) -> eight lanes per component, by two 4x4
-// transposes inside the 128-bit halves (record l in the low half, l + 4 in the high half): cheaper
-// than six gathers on the CPUs we measured.
-template <bool WithVelocity>
-MSFEM_TARGET_AVX2 MSFEM_ALWAYS_INLINE void load_records(const float* base, const int* index,
-                                                        __m256 (&out)[6]) {
-  __m256 r[4];
-  for (int l = 0; l < 4; ++l)
-    r[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(base + kRecord * index[l])),
-                                _mm_load_ps(base + kRecord * index[l + 4]), 1);
-  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
-  out[0] = _mm256_shuffle_ps(t0, t2, 0x44);
-  out[1] = _mm256_shuffle_ps(t0, t2, 0xEE);
-  out[2] = _mm256_shuffle_ps(t1, t3, 0x44);
-  if constexpr (WithVelocity) {
-    out[3] = _mm256_shuffle_ps(t1, t3, 0xEE);
-    __m256 s[4];
-    for (int l = 0; l < 4; ++l)
-      s[l] =
-          _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(base + kRecord * index[l] + 4)),
-                               _mm_load_ps(base + kRecord * index[l + 4] + 4), 1);
-    const __m256 u0 = _mm256_unpacklo_ps(s[0], s[1]), u2 = _mm256_unpacklo_ps(s[2], s[3]);
-    out[4] = _mm256_shuffle_ps(u0, u2, 0x44);
-    out[5] = _mm256_shuffle_ps(u0, u2, 0xEE);
-  }
-}
-
-// The inverse of load_records, pad slots zeroed.
-MSFEM_TARGET_AVX2 MSFEM_ALWAYS_INLINE void store_records(float* base, const int* index,
-                                                         const __m256 (&in)[6]) {
-  const __m256 zero = _mm256_setzero_ps();
-  const __m256 t0 = _mm256_unpacklo_ps(in[0], in[1]), t1 = _mm256_unpackhi_ps(in[0], in[1]);
-  const __m256 t2 = _mm256_unpacklo_ps(in[2], in[3]), t3 = _mm256_unpackhi_ps(in[2], in[3]);
-  const __m256 u0 = _mm256_unpacklo_ps(in[4], in[5]), u1 = _mm256_unpackhi_ps(in[4], in[5]);
-  const __m256 r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
-                       _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
-  const __m256 q[4] = {_mm256_shuffle_ps(u0, zero, 0x44), _mm256_shuffle_ps(u0, zero, 0xEE),
-                       _mm256_shuffle_ps(u1, zero, 0x44), _mm256_shuffle_ps(u1, zero, 0xEE)};
-  for (int l = 0; l < 4; ++l) {
-    _mm256_store_ps(base + kRecord * index[l], _mm256_permute2f128_ps(r[l], q[l], 0x20));
-    _mm256_store_ps(base + kRecord * index[l + 4], _mm256_permute2f128_ps(r[l], q[l], 0x31));
-  }
-}
-
-// 1/√a from the hardware estimate and one Newton step (relative error ~1e-7, float's own).
-MSFEM_TARGET_AVX2 MSFEM_ALWAYS_INLINE __m256 inverse_sqrt(__m256 a) {
-  const __m256 y = _mm256_rsqrt_ps(a);
-  const __m256 half_ay = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), a), y);
-  return _mm256_mul_ps(y, _mm256_fnmadd_ps(half_ay, y, _mm256_set1_ps(1.5f)));
-}
-
-template <bool Damped>
-MSFEM_TARGET_AVX2 double gather_chunks_avx2(const NodeGatherLayout<float, 8>& g,
-                                            const float* __restrict cur, float* __restrict next,
-                                            int begin, int end, float h) {
-  __m256 sum = _mm256_setzero_ps();
-  const __m256 step = _mm256_set1_ps(h);
-  for (int chunk = begin; chunk < end; ++chunk) {
-    const int* lanes = g.lane_node.data() + chunk * 8;
-    __m256 own[6];
-    load_records<true>(cur, lanes, own);
-    __m256 fx = _mm256_setzero_ps(), fy = fx, fz = fx;
-    for (int slot = g.chunk_slot[chunk]; slot < g.chunk_slot[chunk + 1]; slot += 8) {
-      __m256 p[6];
-      load_records<Damped>(cur, g.neighbour.data() + slot, p);
-      const __m256 dx = _mm256_sub_ps(p[0], own[0]);
-      const __m256 dy = _mm256_sub_ps(p[1], own[1]);
-      const __m256 dz = _mm256_sub_ps(p[2], own[2]);
-      const __m256 length2 =
-          _mm256_fmadd_ps(dz, dz, _mm256_fmadd_ps(dy, dy, _mm256_mul_ps(dx, dx)));
-      const __m256 inverse_length = inverse_sqrt(length2);
-      __m256 factor = _mm256_fnmadd_ps(_mm256_loadu_ps(g.k_l0.data() + slot), inverse_length,
-                                       _mm256_loadu_ps(g.k.data() + slot));
-      if constexpr (Damped) {
-        __m256 w = _mm256_mul_ps(_mm256_sub_ps(p[3], own[3]), dx);
-        w = _mm256_fmadd_ps(_mm256_sub_ps(p[4], own[4]), dy, w);
-        w = _mm256_fmadd_ps(_mm256_sub_ps(p[5], own[5]), dz, w);
-        const __m256 cw = _mm256_mul_ps(_mm256_loadu_ps(g.c.data() + slot), w);
-        factor = _mm256_fmadd_ps(cw, _mm256_mul_ps(inverse_length, inverse_length), factor);
-      }
-      fx = _mm256_fmadd_ps(factor, dx, fx);
-      fy = _mm256_fmadd_ps(factor, dy, fy);
-      fz = _mm256_fmadd_ps(factor, dz, fz);
-    }
-    const int at = chunk * 8;
-    const __m256 scale = _mm256_mul_ps(step, _mm256_loadu_ps(g.inverse_mass.data() + at));
-    const __m256 damping = _mm256_loadu_ps(g.damping.data() + at);
-    const __m256 anchor = _mm256_loadu_ps(g.anchor.data() + at);
-    const __m256 force[3] = {fx, fy, fz};
-    __m256 out[6];
-    for (int d = 0; d < 3; ++d) {
-      __m256 total = _mm256_add_ps(force[d], _mm256_loadu_ps(g.load[d].data() + at));
-      total = _mm256_fnmadd_ps(damping, own[3 + d], total);
-      total = _mm256_fnmadd_ps(anchor, own[d], total);
-      out[3 + d] = _mm256_fmadd_ps(scale, total, own[3 + d]);
-      out[d] = _mm256_fmadd_ps(step, out[3 + d], own[d]);
-      sum = _mm256_fmadd_ps(out[3 + d], out[3 + d], sum);
-    }
-    store_records(next, lanes, out);
-  }
-  alignas(32) float lanes_sum[8];
-  _mm256_store_ps(lanes_sum, sum);
-  double total = 0.0;
-  for (float value : lanes_sum)
-    total += value;
-  return total;
+bool cpu_has_avx512() {
+  return cpu_has_avx2() && __builtin_cpu_supports("avx512f");
 }
 
 template <class Real, int W, bool Damped>
@@ -214,6 +108,9 @@ MSFEM_TARGET_AVX2 double gather_chunks_avx2_generic(const NodeGatherLayout<Real,
 }
 #else
 bool cpu_has_avx2() {
+  return false;
+}
+bool cpu_has_avx512() {
   return false;
 }
 #endif
@@ -229,8 +126,11 @@ double run_chunks(bool avx2, const NodeGatherLayout<Real, W>& g, const Real* cur
                   int begin, int end, Real h) {
 #if MSFEM_HAVE_X86_DISPATCH
   if (avx2) {
-    if constexpr (std::is_same_v<Real, float> && W == 8)
-      return gather_chunks_avx2<Damped>(g, cur, next, begin, end, h);
+    if constexpr ((std::is_same_v<Real, float> && W == 8) ||
+                  (std::is_same_v<Real, double> && W == 4))
+      return detail::gather_chunks_avx2<Damped>(g, cur, next, begin, end, h);
+    else if constexpr (std::is_same_v<Real, float> && W == 16)
+      return detail::gather_chunks_avx512<Damped>(g, cur, next, begin, end, h);
     else
       return gather_chunks_avx2_generic<Real, W, Damped>(g, cur, next, begin, end, h);
   }
@@ -243,16 +143,14 @@ double run_chunks(bool avx2, const NodeGatherLayout<Real, W>& g, const Real* cur
 template <class Real>
 constexpr int kLanes = 32 / sizeof(Real);
 
-template <class Real>
+template <class Real, int W>
 class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
-  static constexpr int W = kLanes<Real>;
-
  public:
   GatherExplicitStepper(const MassSpringModel& model, const FastStepperOptions& options)
       : model_(&model),
         team_(std::max(options.threads, 1)),
         soa_(model, options.reorder_nodes, team_.size()),
-        gather_(soa_, team_.size()),
+        gather_(soa_),
         records_{detail::AlignedArray<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedArray<Real>(kRecord * (soa_.num_nodes + 2))} {
     pack();
@@ -286,15 +184,26 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     const Real h = static_cast<Real>(dt);
     std::vector<double> check(team_.size(), 0.0);
     const bool damped = soa_.has_spring_damping;
+    // Blocks are taken from one ticket counter. In each step every member draws tickets until it
+    // gets one past the step's blocks, so a step uses exactly blocks + members tickets and the
+    // next step's tickets start at a known number without resetting the counter.
+    const long blocks = static_cast<long>(gather_.block_begin.size()) - 1;
+    const long per_step = blocks + team_.size();
+    ticket_.store(0, std::memory_order_relaxed);
     const std::function<void(int)> job = [&](int member) {
-      const int begin = gather_.chunk_begin[member], end = gather_.chunk_begin[member + 1];
       int from = current_;
       double sum = 0.0;
       for (int n = 0; n < count; ++n) {
         const Real* cur = records_[from].data();
         Real* next = records_[1 - from].data();
-        sum = damped ? run_chunks<Real, W, true>(use_avx2_, gather_, cur, next, begin, end, h)
-                     : run_chunks<Real, W, false>(use_avx2_, gather_, cur, next, begin, end, h);
+        sum = 0.0;
+        for (long block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step;
+             block < blocks;
+             block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step) {
+          const int begin = gather_.block_begin[block], end = gather_.block_begin[block + 1];
+          sum += damped ? run_chunks<Real, W, true>(use_avx2_, gather_, cur, next, begin, end, h)
+                        : run_chunks<Real, W, false>(use_avx2_, gather_, cur, next, begin, end, h);
+        }
         from = 1 - from;
         if (n + 1 < count) team_.barrier();  // run() itself waits for the last step
       }
@@ -353,6 +262,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   detail::SoaLayout<Real> soa_;
   NodeGatherLayout<Real, W> gather_;
   detail::AlignedArray<Real> records_[2];  // x, v per node (kRecord), previous and next step
+  std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;
   bool use_avx2_ = cpu_has_avx2();
@@ -362,10 +272,12 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
 FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
                                          const FastStepperOptions& options) {
-  if (options.single_precision)
-    impl_ = std::make_unique<GatherExplicitStepper<float>>(model, options);
+  if (options.single_precision && options.allow_avx512 && cpu_has_avx512())
+    impl_ = std::make_unique<GatherExplicitStepper<float, 16>>(model, options);
+  else if (options.single_precision)
+    impl_ = std::make_unique<GatherExplicitStepper<float, 8>>(model, options);
   else
-    impl_ = std::make_unique<GatherExplicitStepper<double>>(model, options);
+    impl_ = std::make_unique<GatherExplicitStepper<double, 4>>(model, options);
 }
 
 FastExplicitStepper::~FastExplicitStepper() = default;

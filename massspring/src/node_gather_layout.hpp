@@ -28,6 +28,7 @@ namespace msfem::massspring::detail {
 
 constexpr int kRecord = 8;
 constexpr int kSortWindow = 64;
+constexpr int kBlockSlots = 4096;
 
 // Cache-line aligned array for the node records (the vector loads assume 32-byte alignment).
 template <class Real>
@@ -58,9 +59,9 @@ struct NodeGatherLayout {
   std::vector<int> neighbour, slot_spring;                   // per slot; slot_spring -1 for padding
   std::vector<Real> k, k_l0, c;                              // per slot
   std::vector<Real> inverse_mass, damping, anchor, load[3];  // per lane
-  std::vector<int> chunk_begin;                              // per thread-team member
+  std::vector<int> block_begin;  // chunk ranges handed out to the threads
 
-  NodeGatherLayout(const SoaLayout<Real>& soa, int members) {
+  explicit NodeGatherLayout(const SoaLayout<Real>& soa) {
     idle_record = soa.num_nodes;
     far_record = soa.num_nodes + 1;
     std::vector<int> free(soa.num_free);
@@ -103,7 +104,7 @@ struct NodeGatherLayout {
     for (auto& l : load)
       l.assign(lane_node.size(), Real(0));
     load_parameters(soa);
-    partition(members);
+    partition();
   }
 
   // Copies the per-spring and per-node constants of the SoA layout into slot and lane order.
@@ -126,18 +127,15 @@ struct NodeGatherLayout {
     }
   }
 
-  // Contiguous chunk ranges with equal shares of slots plus a per-node cost of about two slots.
-  void partition(int members) {
-    chunk_begin.assign(members + 1, num_chunks);
-    chunk_begin[0] = 0;
-    const long total = static_cast<long>(chunk_slot.back()) + 2L * W * num_chunks;
-    int chunk = 0;
-    for (int m = 1; m < members; ++m) {
-      const long target = total * m / members;
-      while (chunk < num_chunks && chunk_slot[chunk] + 2L * W * chunk < target)
-        ++chunk;
-      chunk_begin[m] = chunk;
-    }
+  // Blocks of consecutive chunks, about kBlockSlots slots each, handed out to the threads one at a
+  // time (see fast_stepper.cpp): small enough that a thread the OS pre-empts holds up the others
+  // for one block only, large enough that taking one costs nothing.
+  void partition() {
+    block_begin.assign(1, 0);
+    for (int chunk = 0; chunk < num_chunks; ++chunk)
+      if (chunk_slot[chunk + 1] - chunk_slot[block_begin.back()] >= kBlockSlots)
+        block_begin.push_back(chunk + 1);
+    if (block_begin.back() != num_chunks) block_begin.push_back(num_chunks);
   }
 };
 

@@ -11,6 +11,7 @@ struct FastStepperOptions {
   int threads = 2;                ///< threads in all, the calling one included
   bool single_precision = false;  ///< float arithmetic (twice the SIMD width, ~1e-7 relative)
   bool reorder_nodes = true;      ///< reverse Cuthill-McKee order for memory locality
+  bool allow_avx512 = true;       ///< float: 16 lanes where the CPU has AVX-512 (else 8, AVX2)
 };
 
 /// The real-time explicit stepper: symplectic Euler, which with velocities read at half steps is
