@@ -72,8 +72,9 @@ VolumeMesh broadcast_from_rank_zero(const VolumeMesh& mesh, MPI_Comm communicato
   return result;
 }
 
-/// The triangulation's coarse cells are the mesh's tetrahedra in row order, vertices as given.
-void create_triangulation(const VolumeMesh& mesh, Triangulation<dim>& triangulation) {
+}  // namespace
+
+void create_triangulation(const VolumeMesh& mesh, Triangulation<3>& triangulation) {
   std::vector<Point<dim>> vertices(std::size_t(mesh.num_vertices()));
   for (Eigen::Index i = 0; i < mesh.num_vertices(); ++i)
     vertices[std::size_t(i)] =
@@ -84,6 +85,8 @@ void create_triangulation(const VolumeMesh& mesh, Triangulation<dim>& triangulat
       cells[std::size_t(e)].vertices[k] = unsigned(mesh.tetrahedra(e, k));
   triangulation.create_triangulation(vertices, cells, SubCellData());
 }
+
+namespace {
 
 /// Local cell matrix and load vector of linear elasticity,
 ///   K_ij = int lambda div(phi_i) div(phi_j) + 2 mu eps(phi_i) : eps(phi_j) dx,

@@ -26,6 +26,9 @@ inline Eigen::Vector3d to_eigen(const dealii::Point<3>& p) {
   return {p[0], p[1], p[2]};
 }
 
+/// The triangulation's coarse cells are the mesh's tetrahedra in row order, vertices as given.
+void create_triangulation(const VolumeMesh& mesh, dealii::Triangulation<3>& triangulation);
+
 struct ElasticityProblem::Implementation {
   static constexpr int dim = 3;
   using CellIterator = dealii::DoFHandler<dim>::active_cell_iterator;

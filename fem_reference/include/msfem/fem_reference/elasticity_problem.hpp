@@ -137,6 +137,16 @@ class ElasticityProblem {
   std::filesystem::path output_results(const std::filesystem::path& directory,
                                        const std::string& basename) const;
 
+  /// Writes `<basename>.h5` (datasets `nodes`, `cells`, `displacement`; one file for all ranks,
+  /// through parallel HDF5) and `<basename>.xdmf` naming it, into `directory`, for ParaView, VisIt
+  /// or h5py. Nodes are the mesh vertices (a vertex on a partition boundary appears once per rank
+  /// that owns a cell around it), cells the tetrahedra. The values are nodal, so P2 is written at
+  /// its vertices only: patches with one subdivision, because deal.II 9.4.1's degree-2 HDF5 path
+  /// corrupts the heap. Values carry single-precision round-off (deal.II 9.4 keeps patch data as
+  /// float). Each file is written under a temporary name and renamed. Returns the .xdmf path.
+  std::filesystem::path output_hdf5(const std::filesystem::path& directory,
+                                    const std::string& basename) const;
+
   SolveStatistics statistics() const;
 
   /// Implementation (deal.II types), defined in the sources only.
@@ -145,5 +155,12 @@ class ElasticityProblem {
  private:
   std::unique_ptr<Implementation> impl_;
 };
+
+/// output_hdf5's files for a displacement given at the mesh vertices (a stored FEM result, as
+/// `msfem run` has when its cache answered), written by the calling process alone.
+std::filesystem::path write_vertex_displacement_hdf5(const VolumeMesh& mesh,
+                                                     const Eigen::MatrixX3d& displacement,
+                                                     const std::filesystem::path& directory,
+                                                     const std::string& basename);
 
 }  // namespace msfem::fem_reference
