@@ -225,11 +225,16 @@ struct Avx512Float {
     for (int l = 0; l < 4; ++l) {
       _mm_store_ps(base + kRecord * index[l], _mm512_castps512_ps128(r[l]));
       _mm_store_ps(base + kRecord * index[l] + 4, _mm512_castps512_ps128(q[l]));
-      for (int quarter = 1; quarter < 4; ++quarter) {
-        float* record = base + kRecord * index[l + 4 * quarter];
-        _mm_store_ps(record, _mm512_extractf32x4_ps(r[l], quarter));
-        _mm_store_ps(record + 4, _mm512_extractf32x4_ps(q[l], quarter));
-      }
+      // The lane index must be an immediate: at -O2 GCC does not unroll a loop over it.
+      float* record1 = base + kRecord * index[l + 4];
+      _mm_store_ps(record1, _mm512_extractf32x4_ps(r[l], 1));
+      _mm_store_ps(record1 + 4, _mm512_extractf32x4_ps(q[l], 1));
+      float* record2 = base + kRecord * index[l + 8];
+      _mm_store_ps(record2, _mm512_extractf32x4_ps(r[l], 2));
+      _mm_store_ps(record2 + 4, _mm512_extractf32x4_ps(q[l], 2));
+      float* record3 = base + kRecord * index[l + 12];
+      _mm_store_ps(record3, _mm512_extractf32x4_ps(r[l], 3));
+      _mm_store_ps(record3 + 4, _mm512_extractf32x4_ps(q[l], 3));
     }
   }
 };
