@@ -66,9 +66,10 @@ void naive_step(benchmark::State& state, const std::string& name) {
   annotate(state, model, 1);
 }
 
-void implicit_step(benchmark::State& state, const std::string& name) {
+void implicit_step(benchmark::State& state, const std::string& name, bool single_precision,
+                   double tolerance) {
   const MassSpringModel& model = model_for(name);
-  FastImplicitStepper stepper(model, FastImplicitOptions{2, true, 1e-3, 50});
+  FastImplicitStepper stepper(model, FastImplicitOptions{2, true, tolerance, 50, single_precision});
   stepper.set_state(perturbed_start(model));
   long iterations = 0;
   for (auto _ : state) {
@@ -105,9 +106,17 @@ void register_all() {
     benchmark::RegisterBenchmark(("naive_aos/" + name).c_str(), naive_step, name)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("implicit_soa_2threads/" + name).c_str(), implicit_step, name)
-        ->UseRealTime()
-        ->Unit(benchmark::kMicrosecond);
+    for (const double tolerance : {1e-3, 1e-2}) {
+      const std::string tag = tolerance == 1e-3 ? "tol1e-3" : "tol1e-2";
+      benchmark::RegisterBenchmark(("implicit_double_2threads_" + tag + "/" + name).c_str(),
+                                   implicit_step, name, false, tolerance)
+          ->UseRealTime()
+          ->Unit(benchmark::kMicrosecond);
+      benchmark::RegisterBenchmark(("implicit_float_2threads_" + tag + "/" + name).c_str(),
+                                   implicit_step, name, true, tolerance)
+          ->UseRealTime()
+          ->Unit(benchmark::kMicrosecond);
+    }
   }
 }
 

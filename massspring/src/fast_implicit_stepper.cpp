@@ -1,10 +1,12 @@
-// Backward Euler with matrix-free CG on the structure-of-arrays layout (fast_implicit_stepper.hpp).
+// Backward Euler with matrix-free, block-Jacobi preconditioned CG on the node-centric layout of the
+// explicit stepper (fast_implicit_stepper.hpp).
 
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 
 #include <algorithm>
 #include <cmath>
 
+#include "gather_kernels.hpp"
 #include "soa_layout.hpp"
 #include "thread_team.hpp"
 
@@ -12,248 +14,209 @@ namespace msfem::massspring {
 
 class FastImplicitStepper::Implementation {
  public:
-  Implementation(const MassSpringModel& model, const FastImplicitOptions& options)
+  virtual ~Implementation() = default;
+  virtual void update_parameters(const MassSpringModel& model) = 0;
+  virtual void set_state(const State& state) = 0;
+  virtual State state() const = 0;
+  virtual void step(double h) = 0;
+  virtual int last_iterations() const = 0;
+  virtual int num_nodes() const = 0;
+  virtual int num_springs() const = 0;
+};
+
+namespace {
+
+using detail::kRecord;
+
+template <class Real, int W>
+class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
+ public:
+  GatherImplicitStepper(const MassSpringModel& model, const FastImplicitOptions& options)
       : model_(&model),
         options_(options),
         team_(std::max(options.threads, 1)),
-        soa_(model, options.reorder_nodes, team_.size()) {
-    const int s = soa_.num_springs, n = soa_.num_nodes;
-    for (int c = 0; c < 3; ++c) {
-      normal_[c].assign(s, 0.0);
-      spring_vector_[c].assign(s, 0.0);
-      rhs_[c].assign(n, 0.0);
-      dv_[c].assign(n, 0.0);
-      residual_[c].assign(n, 0.0);
-      direction_[c].assign(n, 0.0);  // zero on constrained nodes, always
-      product_[c].assign(n, 0.0);
-      preconditioned_[c].assign(n, 0.0);
-      inverse_diagonal_[c].assign(n, 0.0);
+        soa_(model, options.reorder_nodes, team_.size()),
+        gather_(soa_),
+        records_(kRecord * (soa_.num_nodes + 2)),
+        p_records_(kRecord * (soa_.num_nodes + 2)) {
+    const std::size_t lanes = gather_.lane_node.size();
+    system_.resize(gather_.chunk_slot.back(), lanes);
+    for (int c = 0; c < 3; ++c)
+      for (auto* v : {&dv_[c], &residual_[c], &direction_[c], &product_[c]}) {
+        v->assign(lanes, Real(0));
+        cg_.dv[c] = dv_[c].data();
+        cg_.r[c] = residual_[c].data();
+        cg_.p[c] = direction_[c].data();
+        cg_.y[c] = product_[c].data();
+      }
+    for (int e = 0; e < 6; ++e) {
+      inverse_block_[e].assign(lanes, Real(0));
+      cg_.inverse_block[e] = inverse_block_[e].data();
     }
-    alpha_.assign(s, 0.0);
-    beta_.assign(s, 0.0);
-    partial_.assign(3 * team_.size(), 0.0);
+    // Equal shares of the layout's blocks of chunks (about equal slot counts).
+    const int blocks = static_cast<int>(gather_.block_begin.size()) - 1;
+    for (int m = 0; m <= team_.size(); ++m)
+      chunk_begin_.push_back(gather_.block_begin[static_cast<long>(blocks) * m / team_.size()]);
+    pack();
+  }
+
+  void update_parameters(const MassSpringModel& model) override {
+    unpack();
+    soa_.load_parameters(model);
+    gather_.load_parameters(soa_);
+    model_ = &model;
+    pack();
+  }
+  void set_state(const State& state) override {
+    soa_.set_state(*model_, state);
+    time_ = state.time;
+    pack();
+  }
+  State state() const override {
+    State out{Eigen::VectorXd(3 * soa_.num_nodes), Eigen::VectorXd(3 * soa_.num_nodes), time_};
+    for (int i = 0; i < soa_.num_nodes; ++i)
+      for (int c = 0; c < 3; ++c) {
+        out.x[3 * soa_.order[i] + c] = records_[kRecord * i + c];
+        out.v[3 * soa_.order[i] + c] = records_[kRecord * i + 3 + c];
+      }
+    return out;
+  }
+  int last_iterations() const override { return last_iterations_; }
+  int num_nodes() const override { return soa_.num_nodes; }
+  int num_springs() const override { return soa_.num_springs; }
+
+  // Solves (M - h D - h² K) Δv = h (f + h K v) by CG from the last step's Δv, to
+  // ‖r‖ <= cg_tolerance ‖b‖ or cg_max_iterations, then v += Δv, x += h v.
+  void step(double dt) override {
+    check_time_step(dt);
+    const Real h = static_cast<Real>(dt);
+    int iterations = 0;
+    const std::function<void(int)> job = [&](int member) {
+      const int c0 = chunk_begin_[member], c1 = chunk_begin_[member + 1];
+      // The direction records hold Δv of the last step (cg_advance): the warm start r = b - A Δv.
+      kernels_.linearise(gather_, records_.data(), system_, cg_, c0, c1, h);
+      kernels_.product(gather_, system_, p_records_.data(), cg_.dv, cg_.y, c0, c1);
+      team_.barrier();  // every product has read Δv's records before they are overwritten
+      double sums[3];   // r·z, r·r, b·b
+      kernels_.cg_start(gather_, system_, cg_, p_records_.data(), c0, c1, sums);
+      reduce(member, sums);  // its barrier also completes the direction records
+      double rz = sums[0], rr = sums[1];
+      const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
+      int iteration = 0;
+      while (iteration < options_.cg_max_iterations && rr > target) {
+        double pap[3] = {
+            kernels_.product(gather_, system_, p_records_.data(), cg_.p, cg_.y, c0, c1), 0.0, 0.0};
+        reduce(member, pap);
+        if (!(pap[0] > 0.0)) break;
+        double next[3];
+        kernels_.cg_update(cg_, static_cast<Real>(rz / pap[0]), c0, c1, next);
+        reduce(member, next);
+        const Real ratio = static_cast<Real>(next[0] / rz);
+        rz = next[0];
+        rr = next[1];
+        kernels_.cg_direction(gather_, cg_, p_records_.data(), ratio, c0, c1);
+        team_.barrier();  // directions complete before the next product reads them
+        ++iteration;
+      }
+      // No barrier: every product of this step has ended at the last reduce or barrier.
+      kernels_.cg_advance(gather_, cg_, records_.data(), p_records_.data(), c0, c1, h);
+      if (member == 0) iterations = iteration;
+    };
+    team_.run(job);
+    last_iterations_ = iterations;
+    time_ += dt;
+  }
+
+ private:
+  // Sums per-member values over the team; every member gets the same totals. Two alternating
+  // buffers: a member can only reuse one after everyone has passed the barrier of the other.
+  void reduce(int member, double (&values)[3]) {
+    double* mine = partial_[parity_[member]] + 3 * member;
+    for (int k = 0; k < 3; ++k)
+      mine[k] = values[k];
+    team_.barrier();
+    const double* all = partial_[parity_[member]];
+    for (int k = 0; k < 3; ++k) {
+      values[k] = 0.0;
+      for (int m = 0; m < team_.size(); ++m)
+        values[k] += all[3 * m + k];
+    }
+    parity_[member] ^= 1;
+  }
+
+  void pack() {
+    for (auto* buffer : {&records_, &p_records_}) {
+      std::fill(buffer->data(), buffer->data() + buffer->size(), Real(0));
+      for (int c = 0; c < 3; ++c)
+        (*buffer)[kRecord * gather_.far_record + c] = Real(1e15);
+    }
+    for (int i = 0; i < soa_.num_nodes; ++i)
+      for (int c = 0; c < 3; ++c) {
+        records_[kRecord * i + c] = soa_.x[c][i];
+        records_[kRecord * i + 3 + c] = soa_.v[c][i];
+      }
+  }
+  void unpack() {
+    for (int i = 0; i < soa_.num_nodes; ++i)
+      for (int c = 0; c < 3; ++c) {
+        soa_.x[c][i] = records_[kRecord * i + c];
+        soa_.v[c][i] = records_[kRecord * i + 3 + c];
+      }
   }
 
   const MassSpringModel* model_;
   FastImplicitOptions options_;
   detail::ThreadTeam team_;
-  detail::SoaLayout<double> soa_;
+  detail::SoaLayout<Real> soa_;
+  detail::NodeGatherLayout<Real, W> gather_;
+  detail::Kernels<Real, W> kernels_;
+  detail::AlignedArray<Real> records_;    // x, v per node
+  detail::AlignedArray<Real> p_records_;  // CG direction per node (zero on constrained nodes)
+  detail::ImplicitCoefficients<Real> system_;
+  std::vector<Real> dv_[3], residual_[3], direction_[3], product_[3];  // product_ also holds z
+  std::vector<Real> inverse_block_[6];
+  detail::CgVectors<Real> cg_;
+  std::vector<int> chunk_begin_;
+  double partial_[2][3 * 64] = {};
+  int parity_[64] = {};
   double time_ = 0.0;
   int last_iterations_ = 0;
-
-  void step(double h) {
-    check_time_step(h);
-    int iterations = 0;
-    const std::function<void(int)> job = [&](int member) {
-      const int s0 = soa_.spring_begin[member], s1 = soa_.spring_begin[member + 1];
-      const int n0 = soa_.node_begin[member], n1 = soa_.node_begin[member + 1];
-      linearise(s0, s1, h);
-      team_.barrier();
-      assemble_rhs_and_diagonal(n0, n1, h);
-      // Warm start: r = b - A Δv_previous.
-      copy(dv_, direction_, n0, n1);
-      team_.barrier();
-      product_springs(s0, s1);
-      team_.barrier();
-      double rz = 0.0, rr = 0.0, bb = 0.0;
-      product_nodes(n0, n1, h);
-      {
-        double local_rz = 0.0, local_rr = 0.0, local_bb = 0.0;
-        for (int i = n0; i < n1; ++i)
-          for (int c = 0; c < 3; ++c) {
-            residual_[c][i] = rhs_[c][i] - product_[c][i];
-            preconditioned_[c][i] = inverse_diagonal_[c][i] * residual_[c][i];
-            direction_[c][i] = preconditioned_[c][i];
-            local_rz += residual_[c][i] * preconditioned_[c][i];
-            local_rr += residual_[c][i] * residual_[c][i];
-            local_bb += rhs_[c][i] * rhs_[c][i];
-          }
-        reduce(member, local_rz, local_rr, local_bb, rz, rr, bb);
-      }
-      const double target = options_.cg_tolerance * options_.cg_tolerance * bb;
-      int iteration = 0;
-      while (iteration < options_.cg_max_iterations && rr > target) {
-        product_springs(s0, s1);
-        team_.barrier();
-        product_nodes(n0, n1, h);
-        double local_pap = 0.0;
-        for (int i = n0; i < n1; ++i)
-          for (int c = 0; c < 3; ++c)
-            local_pap += direction_[c][i] * product_[c][i];
-        double pap = 0.0, unused1 = 0.0, unused2 = 0.0;
-        reduce(member, local_pap, 0.0, 0.0, pap, unused1, unused2);
-        if (!(pap > 0.0)) break;
-        const double step_length = rz / pap;
-        double local_rz = 0.0, local_rr = 0.0;
-        for (int i = n0; i < n1; ++i)
-          for (int c = 0; c < 3; ++c) {
-            dv_[c][i] += step_length * direction_[c][i];
-            residual_[c][i] -= step_length * product_[c][i];
-            preconditioned_[c][i] = inverse_diagonal_[c][i] * residual_[c][i];
-            local_rz += residual_[c][i] * preconditioned_[c][i];
-            local_rr += residual_[c][i] * residual_[c][i];
-          }
-        double rz_next = 0.0;
-        reduce(member, local_rz, local_rr, 0.0, rz_next, rr, unused2);
-        const double ratio = rz_next / rz;
-        rz = rz_next;
-        for (int i = n0; i < n1; ++i)
-          for (int c = 0; c < 3; ++c)
-            direction_[c][i] = preconditioned_[c][i] + ratio * direction_[c][i];
-        team_.barrier();  // directions complete before the next spring pass reads them
-        ++iteration;
-      }
-      // v += Δv, x += h v on the free nodes.
-      for (int i = n0; i < n1; ++i)
-        for (int c = 0; c < 3; ++c) {
-          soa_.v[c][i] += dv_[c][i];
-          soa_.x[c][i] += h * soa_.v[c][i];
-        }
-      if (member == 0) iterations = iteration;
-    };
-    team_.run(job);
-    last_iterations_ = iterations;
-    time_ += h;
-  }
-
- private:
-  // Per spring: the force (into spring_vector_), n, and the coefficients α, β of the system block,
-  // plus h K_s w for the right-hand side (added to spring_vector_).
-  void linearise(int begin, int end, double h) {
-    for (int s = begin; s < end; ++s) {
-      const int i = soa_.a[s], j = soa_.b[s];
-      double d[3], w[3];
-      for (int c = 0; c < 3; ++c) {
-        d[c] = soa_.x[c][j] - soa_.x[c][i];
-        w[c] = soa_.v[c][j] - soa_.v[c][i];
-      }
-      const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-      const double n[3] = {d[0] / length, d[1] / length, d[2] / length};
-      const double n_w = n[0] * w[0] + n[1] * w[1] + n[2] * w[2];
-      const double k = soa_.stiffness[s];
-      const double tau = std::max(0.0, 1.0 - soa_.rest_length[s] / length);
-      const double force = k * (length - soa_.rest_length[s]) + soa_.damping[s] * n_w;
-      alpha_[s] = h * h * k * tau;
-      beta_[s] = h * soa_.damping[s] + h * h * k * (1.0 - tau);
-      // f_s + h K_s w, K_s w = k τ w + k (1 - τ)(n·w) n
-      for (int c = 0; c < 3; ++c) {
-        normal_[c][s] = n[c];
-        spring_vector_[c][s] = force * n[c] + h * (k * tau * w[c] + k * (1.0 - tau) * n_w * n[c]);
-      }
-    }
-  }
-
-  // b = h (F + h K v) and the exact diagonal of M - hD - h²K, per free node.
-  void assemble_rhs_and_diagonal(int begin, int end, double h) {
-    for (int i = begin; i < end; ++i) {
-      const double anchor = soa_.anchor_stiffness[i];
-      const double damping = soa_.node_damping[i];
-      double sum[3] = {0.0, 0.0, 0.0};
-      double diagonal[3];
-      for (int c = 0; c < 3; ++c)
-        diagonal[c] = soa_.mass[i] + h * damping + h * h * anchor;
-      for (int e = soa_.offset[i]; e < soa_.offset[i + 1]; ++e) {
-        const int s = soa_.incident[e];
-        for (int c = 0; c < 3; ++c) {
-          sum[c] += soa_.sign[e] * spring_vector_[c][s];
-          diagonal[c] += alpha_[s] + beta_[s] * normal_[c][s] * normal_[c][s];
-        }
-      }
-      for (int c = 0; c < 3; ++c) {
-        const double force = soa_.load[c][i] - damping * soa_.v[c][i] - anchor * soa_.x[c][i] +
-                             sum[c] - h * anchor * soa_.v[c][i];
-        rhs_[c][i] = h * force;
-        inverse_diagonal_[c][i] = 1.0 / diagonal[c];
-      }
-    }
-  }
-
-  // y_s = α q + β (n·q) n with q = p_b - p_a.
-  void product_springs(int begin, int end) {
-    for (int s = begin; s < end; ++s) {
-      const int i = soa_.a[s], j = soa_.b[s];
-      const double qx = direction_[0][j] - direction_[0][i];
-      const double qy = direction_[1][j] - direction_[1][i];
-      const double qz = direction_[2][j] - direction_[2][i];
-      const double projected =
-          beta_[s] * (normal_[0][s] * qx + normal_[1][s] * qy + normal_[2][s] * qz);
-      spring_vector_[0][s] = alpha_[s] * qx + projected * normal_[0][s];
-      spring_vector_[1][s] = alpha_[s] * qy + projected * normal_[1][s];
-      spring_vector_[2][s] = alpha_[s] * qz + projected * normal_[2][s];
-    }
-  }
-
-  // (A p)_i = (m + h c + h² k_a) p_i - Σ sign y_s.
-  void product_nodes(int begin, int end, double h) {
-    for (int i = begin; i < end; ++i) {
-      const double own = soa_.mass[i] + h * soa_.node_damping[i] + h * h * soa_.anchor_stiffness[i];
-      double sum[3] = {0.0, 0.0, 0.0};
-      for (int e = soa_.offset[i]; e < soa_.offset[i + 1]; ++e) {
-        const int s = soa_.incident[e];
-        for (int c = 0; c < 3; ++c)
-          sum[c] += soa_.sign[e] * spring_vector_[c][s];
-      }
-      for (int c = 0; c < 3; ++c)
-        product_[c][i] = own * direction_[c][i] - sum[c];
-    }
-  }
-
-  static void copy(const std::vector<double> (&from)[3], std::vector<double> (&to)[3], int begin,
-                   int end) {
-    for (int c = 0; c < 3; ++c)
-      std::copy(from[c].begin() + begin, from[c].begin() + end, to[c].begin() + begin);
-  }
-
-  // Sums three per-member values over the team; every member gets the same totals.
-  void reduce(int member, double a, double b, double c, double& sum_a, double& sum_b,
-              double& sum_c) {
-    partial_[3 * member] = a;
-    partial_[3 * member + 1] = b;
-    partial_[3 * member + 2] = c;
-    team_.barrier();
-    sum_a = sum_b = sum_c = 0.0;
-    for (int m = 0; m < team_.size(); ++m) {
-      sum_a += partial_[3 * m];
-      sum_b += partial_[3 * m + 1];
-      sum_c += partial_[3 * m + 2];
-    }
-    team_.barrier();  // everyone has read before anyone writes again
-  }
-
-  std::vector<double> normal_[3], spring_vector_[3];
-  std::vector<double> alpha_, beta_;
-  std::vector<double> rhs_[3], dv_[3], residual_[3], direction_[3], product_[3], preconditioned_[3],
-      inverse_diagonal_[3];
-  std::vector<double> partial_;
 };
 
+}  // namespace
+
 FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
-                                         const FastImplicitOptions& options)
-    : impl_(std::make_unique<Implementation>(model, options)) {}
+                                         const FastImplicitOptions& options) {
+  if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
+  if (options.single_precision && detail::preferred_lanes<float>(true) == 16)
+    impl_ = std::make_unique<GatherImplicitStepper<float, 16>>(model, options);
+  else if (options.single_precision)
+    impl_ = std::make_unique<GatherImplicitStepper<float, 8>>(model, options);
+  else
+    impl_ = std::make_unique<GatherImplicitStepper<double, 4>>(model, options);
+}
 FastImplicitStepper::~FastImplicitStepper() = default;
 
 void FastImplicitStepper::update_parameters(const MassSpringModel& model) {
-  impl_->soa_.load_parameters(model);
-  impl_->model_ = &model;
+  impl_->update_parameters(model);
 }
 void FastImplicitStepper::set_state(const State& state) {
-  impl_->soa_.set_state(*impl_->model_, state);
-  impl_->time_ = state.time;
+  impl_->set_state(state);
 }
 State FastImplicitStepper::state() const {
-  return impl_->soa_.state(impl_->time_);
+  return impl_->state();
 }
 void FastImplicitStepper::step(double dt) {
   impl_->step(dt);
 }
 int FastImplicitStepper::last_cg_iterations() const {
-  return impl_->last_iterations_;
+  return impl_->last_iterations();
 }
 int FastImplicitStepper::num_nodes() const {
-  return impl_->soa_.num_nodes;
+  return impl_->num_nodes();
 }
 int FastImplicitStepper::num_springs() const {
-  return impl_->soa_.num_springs;
+  return impl_->num_springs();
 }
 
 }  // namespace msfem::massspring

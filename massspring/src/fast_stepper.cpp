@@ -5,22 +5,12 @@
 #include <atomic>
 #include <cmath>
 #include <sstream>
-#include <type_traits>
 
+#include "gather_kernels.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/stability.hpp"
-#include "node_gather_layout.hpp"
 #include "soa_layout.hpp"
 #include "thread_team.hpp"
-
-#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__)
-#define MSFEM_HAVE_X86_DISPATCH 1
-#include "gather_kernels_x86.hpp"
-#define MSFEM_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define MSFEM_HAVE_X86_DISPATCH 0
-#define MSFEM_ALWAYS_INLINE inline
-#endif
 
 namespace msfem::massspring {
 
@@ -40,108 +30,6 @@ namespace {
 
 using detail::kRecord;
 using detail::NodeGatherLayout;
-
-// Portable kernel (baseline x86-64, other CPUs, and double precision): every chunk of W nodes
-// gathers its springs from the records of the previous step, `cur`, and writes the new x and v of
-// its nodes to `next` (symplectic Euler). Returns Σ v² as a cheap finiteness check.
-//   f_i = Σ_j [k - k l0 / l + c (w·d) / l²] d,   d = x_j - x_i, w = v_j - v_i, l = |d|
-template <class Real, int W, bool Damped>
-MSFEM_ALWAYS_INLINE double gather_chunks(const NodeGatherLayout<Real, W>& g,
-                                         const Real* __restrict cur, Real* __restrict next,
-                                         int begin, int end, Real h) {
-  Real sum = 0;
-  for (int chunk = begin; chunk < end; ++chunk) {
-    const int* lanes = g.lane_node.data() + chunk * W;
-    Real own[6][W], force[3][W];
-    for (int lane = 0; lane < W; ++lane) {
-      for (int q = 0; q < 6; ++q)
-        own[q][lane] = cur[kRecord * lanes[lane] + q];
-      force[0][lane] = force[1][lane] = force[2][lane] = Real(0);
-    }
-    for (int slot = g.chunk_slot[chunk]; slot < g.chunk_slot[chunk + 1]; slot += W) {
-      for (int lane = 0; lane < W; ++lane) {
-        const Real* __restrict p = cur + kRecord * g.neighbour[slot + lane];
-        const Real dx = p[0] - own[0][lane];
-        const Real dy = p[1] - own[1][lane];
-        const Real dz = p[2] - own[2][lane];
-        const Real inverse_length = Real(1) / std::sqrt(dx * dx + dy * dy + dz * dz);
-        Real factor = g.k[slot + lane] - g.k_l0[slot + lane] * inverse_length;
-        if constexpr (Damped) {
-          const Real w =
-              (p[3] - own[3][lane]) * dx + (p[4] - own[4][lane]) * dy + (p[5] - own[5][lane]) * dz;
-          factor += g.c[slot + lane] * w * inverse_length * inverse_length;
-        }
-        force[0][lane] += factor * dx;
-        force[1][lane] += factor * dy;
-        force[2][lane] += factor * dz;
-      }
-    }
-    for (int lane = 0; lane < W; ++lane) {
-      const int at = chunk * W + lane;
-      Real* __restrict out = next + kRecord * lanes[lane];
-      const Real scale = h * g.inverse_mass[at];
-      for (int d = 0; d < 3; ++d) {
-        const Real total = force[d][lane] + g.load[d][at] - g.damping[at] * own[3 + d][lane] -
-                           g.anchor[at] * own[d][lane];
-        out[3 + d] = own[3 + d][lane] + scale * total;
-        out[d] = own[d][lane] + h * out[3 + d];
-        sum += out[3 + d] * out[3 + d];
-      }
-    }
-  }
-  return static_cast<double>(sum);
-}
-
-#if MSFEM_HAVE_X86_DISPATCH
-bool cpu_has_avx2() {
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-}
-bool cpu_has_avx512() {
-  return cpu_has_avx2() && __builtin_cpu_supports("avx512f");
-}
-
-template <class Real, int W, bool Damped>
-MSFEM_TARGET_AVX2 double gather_chunks_avx2_generic(const NodeGatherLayout<Real, W>& g,
-                                                    const Real* cur, Real* next, int begin, int end,
-                                                    Real h) {
-  return gather_chunks<Real, W, Damped>(g, cur, next, begin, end, h);
-}
-#else
-bool cpu_has_avx2() {
-  return false;
-}
-bool cpu_has_avx512() {
-  return false;
-}
-#endif
-
-template <class Real, int W, bool Damped>
-double gather_chunks_default(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
-                             int begin, int end, Real h) {
-  return gather_chunks<Real, W, Damped>(g, cur, next, begin, end, h);
-}
-
-template <class Real, int W, bool Damped>
-double run_chunks(bool avx2, const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
-                  int begin, int end, Real h) {
-#if MSFEM_HAVE_X86_DISPATCH
-  if (avx2) {
-    if constexpr ((std::is_same_v<Real, float> && W == 8) ||
-                  (std::is_same_v<Real, double> && W == 4))
-      return detail::gather_chunks_avx2<Damped>(g, cur, next, begin, end, h);
-    else if constexpr (std::is_same_v<Real, float> && W == 16)
-      return detail::gather_chunks_avx512<Damped>(g, cur, next, begin, end, h);
-    else
-      return gather_chunks_avx2_generic<Real, W, Damped>(g, cur, next, begin, end, h);
-  }
-#endif
-  (void)avx2;
-  return gather_chunks_default<Real, W, Damped>(g, cur, next, begin, end, h);
-}
-
-// Lanes per chunk: one 256-bit vector.
-template <class Real>
-constexpr int kLanes = 32 / sizeof(Real);
 
 template <class Real, int W>
 class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
@@ -201,8 +89,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
              block < blocks;
              block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step) {
           const int begin = gather_.block_begin[block], end = gather_.block_begin[block + 1];
-          sum += damped ? run_chunks<Real, W, true>(use_avx2_, gather_, cur, next, begin, end, h)
-                        : run_chunks<Real, W, false>(use_avx2_, gather_, cur, next, begin, end, h);
+          sum += kernels_.explicit_step(damped, gather_, cur, next, begin, end, h);
         }
         from = 1 - from;
         if (n + 1 < count) team_.barrier();  // run() itself waits for the last step
@@ -265,14 +152,14 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;
-  bool use_avx2_ = cpu_has_avx2();
+  detail::Kernels<Real, W> kernels_;
 };
 
 }  // namespace
 
 FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
                                          const FastStepperOptions& options) {
-  if (options.single_precision && options.allow_avx512 && cpu_has_avx512())
+  if (options.single_precision && detail::preferred_lanes<float>(options.allow_avx512) == 16)
     impl_ = std::make_unique<GatherExplicitStepper<float, 16>>(model, options);
   else if (options.single_precision)
     impl_ = std::make_unique<GatherExplicitStepper<float, 8>>(model, options);

@@ -1,10 +1,8 @@
 #pragma once
 
-// x86 vector kernels of the node-centric explicit step (internal; included by fast_stepper.cpp
-// only where MSFEM_HAVE_X86_DISPATCH). One kernel, written against a small set of vector
-// operations, instantiated for AVX2 float (8 lanes), AVX2 double (4) and AVX-512 float (16); each
-// set carries its own target attribute, so the library needs no -march flag and fast_stepper.cpp
-// picks one at run time.
+// x86 vector operations for the node-centric kernels (internal; see gather_kernels.hpp): AVX2
+// float (8 lanes), AVX2 double (4) and AVX-512 float (16). Each set carries its own target
+// attribute, so the library needs no -march flag and the steppers pick one at run time.
 //
 // Neighbour records are not gathered element by element: a record (x y z vx | vy vz pad pad) is one
 // or two vector loads, and a register transpose turns W records into six W-lane vectors. On the
@@ -16,7 +14,6 @@
 
 #define MSFEM_TARGET_AVX2 __attribute__((target("avx2,fma")))
 #define MSFEM_TARGET_AVX512 __attribute__((target("avx512f,avx2,fma")))
-#define MSFEM_INLINE inline __attribute__((always_inline))
 
 namespace msfem::massspring::detail {
 
@@ -25,6 +22,10 @@ struct Avx2Float {
   using V = __m256;
   static constexpr int W = 8;
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V load(const float* p) { return _mm256_loadu_ps(p); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store(float* p, V a) { _mm256_storeu_ps(p, a); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V max(V a, V b) { return _mm256_max_ps(a, b); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V sqrt(V a) { return _mm256_sqrt_ps(a); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V div(V a, V b) { return _mm256_div_ps(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V set1(float a) { return _mm256_set1_ps(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V add(V a, V b) { return _mm256_add_ps(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sub(V a, V b) { return _mm256_sub_ps(a, b); }
@@ -95,6 +96,10 @@ struct Avx2Double {
   using V = __m256d;
   static constexpr int W = 4;
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V load(const double* p) { return _mm256_loadu_pd(p); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store(double* p, V a) { _mm256_storeu_pd(p, a); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V max(V a, V b) { return _mm256_max_pd(a, b); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V sqrt(V a) { return _mm256_sqrt_pd(a); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V div(V a, V b) { return _mm256_div_pd(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V set1(double a) { return _mm256_set1_pd(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V add(V a, V b) { return _mm256_add_pd(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sub(V a, V b) { return _mm256_sub_pd(a, b); }
@@ -158,6 +163,10 @@ struct Avx512Float {
   using V = __m512;
   static constexpr int W = 16;
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V load(const float* p) { return _mm512_loadu_ps(p); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store(float* p, V a) { _mm512_storeu_ps(p, a); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V max(V a, V b) { return _mm512_max_ps(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V sqrt(V a) { return _mm512_sqrt_ps(a); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V div(V a, V b) { return _mm512_div_ps(a, b); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V set1(float a) { return _mm512_set1_ps(a); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V add(V a, V b) { return _mm512_add_ps(a, b); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V sub(V a, V b) { return _mm512_sub_ps(a, b); }
@@ -238,33 +247,5 @@ struct Avx512Float {
     }
   }
 };
-
-#define MSFEM_GATHER_TARGET MSFEM_TARGET_AVX2
-#define MSFEM_GATHER_NAME gather_chunks_simd_avx2
-#include "gather_kernel_body.inc"
-#undef MSFEM_GATHER_TARGET
-#undef MSFEM_GATHER_NAME
-#define MSFEM_GATHER_TARGET MSFEM_TARGET_AVX512
-#define MSFEM_GATHER_NAME gather_chunks_simd_avx512
-#include "gather_kernel_body.inc"
-#undef MSFEM_GATHER_TARGET
-#undef MSFEM_GATHER_NAME
-
-template <bool Damped>
-MSFEM_TARGET_AVX2 double gather_chunks_avx2(const NodeGatherLayout<float, 8>& g, const float* cur,
-                                            float* next, int begin, int end, float h) {
-  return gather_chunks_simd_avx2<Avx2Float, Damped>(g, cur, next, begin, end, h);
-}
-template <bool Damped>
-MSFEM_TARGET_AVX2 double gather_chunks_avx2(const NodeGatherLayout<double, 4>& g, const double* cur,
-                                            double* next, int begin, int end, double h) {
-  return gather_chunks_simd_avx2<Avx2Double, Damped>(g, cur, next, begin, end, h);
-}
-template <bool Damped>
-MSFEM_TARGET_AVX512 double gather_chunks_avx512(const NodeGatherLayout<float, 16>& g,
-                                                const float* cur, float* next, int begin, int end,
-                                                float h) {
-  return gather_chunks_simd_avx512<Avx512Float, Damped>(g, cur, next, begin, end, h);
-}
 
 }  // namespace msfem::massspring::detail

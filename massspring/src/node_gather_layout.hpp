@@ -56,9 +56,9 @@ struct NodeGatherLayout {
   int idle_record = 0, far_record = 0;  // num_nodes, num_nodes + 1
   std::vector<int> lane_node;           // chunk * W + lane -> SoA node (idle_record when empty)
   std::vector<int> chunk_slot, chunk_width;
-  std::vector<int> neighbour, slot_spring;                   // per slot; slot_spring -1 for padding
-  std::vector<Real> k, k_l0, c;                              // per slot
-  std::vector<Real> inverse_mass, damping, anchor, load[3];  // per lane
+  std::vector<int> neighbour, slot_spring;  // per slot; slot_spring -1 for padding
+  std::vector<Real> k, k_l0, c;             // per slot
+  std::vector<Real> mass, inverse_mass, damping, anchor, load[3];  // per lane (idle: mass 1)
   std::vector<int> block_begin;  // chunk ranges handed out to the threads
 
   explicit NodeGatherLayout(const SoaLayout<Real>& soa) {
@@ -98,6 +98,7 @@ struct NodeGatherLayout {
     k.assign(chunk_slot.back(), Real(0));
     k_l0.assign(chunk_slot.back(), Real(0));
     c.assign(chunk_slot.back(), Real(0));
+    mass.assign(lane_node.size(), Real(1));
     inverse_mass.assign(lane_node.size(), Real(0));
     damping.assign(lane_node.size(), Real(0));
     anchor.assign(lane_node.size(), Real(0));
@@ -119,6 +120,7 @@ struct NodeGatherLayout {
     for (std::size_t lane = 0; lane < lane_node.size(); ++lane) {
       const int i = lane_node[lane];
       if (i == idle_record) continue;
+      mass[lane] = soa.mass[i];
       inverse_mass[lane] = soa.inverse_mass[i];
       damping[lane] = soa.node_damping[i];
       anchor[lane] = soa.anchor_stiffness[i];
@@ -137,6 +139,30 @@ struct NodeGatherLayout {
         block_begin.push_back(chunk + 1);
     if (block_begin.back() != num_chunks) block_begin.push_back(num_chunks);
   }
+};
+
+// The linearised backward-Euler system of one step in slot and lane order (fast implicit stepper):
+// per slot y += α q + (e·q) e for q = p_j - p_i, stored per group of W slots as W α, then W of each
+// component of e (one stream for the product to read); per lane the diagonal term m + h c + h² k_a,
+// and the right-hand side.
+template <class Real>
+struct ImplicitCoefficients {
+  std::vector<Real> slot_terms;   // 4 per slot
+  std::vector<Real> own, rhs[3];  // per lane
+
+  void resize(std::size_t slots, std::size_t lanes) {
+    slot_terms.assign(4 * slots, Real(0));
+    own.assign(lanes, Real(1));
+    for (auto& v : rhs)
+      v.assign(lanes, Real(0));
+  }
+};
+
+// The CG vectors of the fast implicit stepper in lane order (pointers into its arrays), with the
+// inverted 3x3 diagonal blocks (xx yy zz xy xz yz) of the block-Jacobi preconditioner.
+template <class Real>
+struct CgVectors {
+  Real *dv[3], *r[3], *p[3], *y[3], *inverse_block[6];
 };
 
 }  // namespace msfem::massspring::detail

@@ -156,6 +156,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
     implicit_options.threads = options.threads;
     implicit_options.cg_tolerance = options.implicit_cg_tolerance;
     implicit_options.cg_max_iterations = options.implicit_cg_max_iterations;
+    implicit_options.single_precision = options.single_precision;
     FastImplicitStepper implicit(model, implicit_options);
     implicit.set_state(start);
     long iterations = 0, steps = 0;

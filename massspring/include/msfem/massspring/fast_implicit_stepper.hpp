@@ -14,6 +14,7 @@ struct FastImplicitOptions {
   /// Δv; the step stays stable because the matrix is SPD and the error is damped by the next step.
   double cg_tolerance = 1e-3;
   int cg_max_iterations = 50;
+  bool single_precision = false;  ///< float arithmetic and wider vectors
 };
 
 /// Backward Euler on the same structure-of-arrays layout and thread team as FastExplicitStepper

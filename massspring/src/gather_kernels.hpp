@@ -1,0 +1,210 @@
+#pragma once
+
+// The node-centric kernels of the fast steppers (internal): the explicit step, and the backward-
+// Euler linearisation and matrix-vector product. One body (gather_kernel_body.inc), written against
+// a small set of vector operations, instantiated for a portable lane-array set (any CPU) and on
+// x86 for AVX2 (float 8 lanes, double 4) and AVX-512 (float 16); `Kernels` picks one at run time.
+
+#include <cmath>
+#include <type_traits>
+
+#include "node_gather_layout.hpp"
+
+#if (defined(__x86_64__) || defined(__i386__)) && defined(__GNUC__)
+#define MSFEM_HAVE_X86_DISPATCH 1
+#define MSFEM_INLINE inline __attribute__((always_inline))
+#include "gather_kernels_x86.hpp"
+#else
+#define MSFEM_HAVE_X86_DISPATCH 0
+#define MSFEM_INLINE inline
+#endif
+
+namespace msfem::massspring::detail {
+
+// W lanes as a plain array; the compiler vectorises what it can. Same results as the x86 sets up
+// to rounding (an exact 1/√ here).
+template <class R, int N>
+struct PortableLanes {
+  using Real = R;
+  static constexpr int W = N;
+  struct V {
+    R v[N];
+  };
+  template <class F>
+  static MSFEM_INLINE V map(F f) {
+    V out;
+    for (int l = 0; l < N; ++l)
+      out.v[l] = f(l);
+    return out;
+  }
+  static MSFEM_INLINE V load(const R* p) {
+    return map([&](int l) { return p[l]; });
+  }
+  static MSFEM_INLINE void store(R* p, V a) {
+    for (int l = 0; l < N; ++l)
+      p[l] = a.v[l];
+  }
+  static MSFEM_INLINE V set1(R a) {
+    return map([&](int) { return a; });
+  }
+  static MSFEM_INLINE V add(V a, V b) {
+    return map([&](int l) { return a.v[l] + b.v[l]; });
+  }
+  static MSFEM_INLINE V sub(V a, V b) {
+    return map([&](int l) { return a.v[l] - b.v[l]; });
+  }
+  static MSFEM_INLINE V mul(V a, V b) {
+    return map([&](int l) { return a.v[l] * b.v[l]; });
+  }
+  static MSFEM_INLINE V max(V a, V b) {
+    return map([&](int l) { return a.v[l] > b.v[l] ? a.v[l] : b.v[l]; });
+  }
+  static MSFEM_INLINE V fmadd(V a, V b, V c) {
+    return map([&](int l) { return a.v[l] * b.v[l] + c.v[l]; });
+  }
+  static MSFEM_INLINE V fnmadd(V a, V b, V c) {
+    return map([&](int l) { return c.v[l] - a.v[l] * b.v[l]; });
+  }
+  static MSFEM_INLINE V div(V a, V b) {
+    return map([&](int l) { return a.v[l] / b.v[l]; });
+  }
+  static MSFEM_INLINE V sqrt(V a) {
+    return map([&](int l) { return std::sqrt(a.v[l]); });
+  }
+  static MSFEM_INLINE V inverse_sqrt(V a) {
+    return map([&](int l) { return R(1) / std::sqrt(a.v[l]); });
+  }
+  static MSFEM_INLINE double sum(V a) {
+    double total = 0.0;
+    for (int l = 0; l < N; ++l)
+      total += a.v[l];
+    return total;
+  }
+  template <bool WithVelocity>
+  static MSFEM_INLINE void load_records(const R* base, const int* index, V (&out)[6]) {
+    for (int q = 0; q < (WithVelocity ? 6 : 3); ++q)
+      for (int l = 0; l < N; ++l)
+        out[q].v[l] = base[kRecord * index[l] + q];
+  }
+  static MSFEM_INLINE void store_records(R* base, const int* index, const V (&in)[6]) {
+    for (int l = 0; l < N; ++l)
+      for (int q = 0; q < 6; ++q)
+        base[kRecord * index[l] + q] = in[q].v[l];
+  }
+};
+
+#define MSFEM_GATHER_TARGET
+#define MSFEM_KERNEL(name) name##_portable
+#include "gather_kernel_body.inc"
+#undef MSFEM_GATHER_TARGET
+#undef MSFEM_KERNEL
+
+#if MSFEM_HAVE_X86_DISPATCH
+#define MSFEM_GATHER_TARGET MSFEM_TARGET_AVX2
+#define MSFEM_KERNEL(name) name##_avx2
+#include "gather_kernel_body.inc"
+#undef MSFEM_GATHER_TARGET
+#undef MSFEM_KERNEL
+#define MSFEM_GATHER_TARGET MSFEM_TARGET_AVX512
+#define MSFEM_KERNEL(name) name##_avx512
+#include "gather_kernel_body.inc"
+#undef MSFEM_GATHER_TARGET
+#undef MSFEM_KERNEL
+
+inline bool cpu_has_avx2() {
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+inline bool cpu_has_avx512() {
+  return cpu_has_avx2() && __builtin_cpu_supports("avx512f");
+}
+#else
+inline bool cpu_has_avx2() {
+  return false;
+}
+inline bool cpu_has_avx512() {
+  return false;
+}
+#endif
+
+// Lanes per chunk for a precision: 16 floats where AVX-512 may be used, else one 256-bit vector.
+template <class Real>
+int preferred_lanes(bool allow_avx512) {
+  if (std::is_same_v<Real, float>) return allow_avx512 && cpu_has_avx512() ? 16 : 8;
+  return 4;
+}
+
+#if MSFEM_HAVE_X86_DISPATCH
+#define MSFEM_DISPATCH(NAME, ...)                           \
+  if constexpr (W == 16) {                                  \
+    return NAME##_avx512<Avx512Float>(__VA_ARGS__);         \
+  } else if constexpr (W == 32 / sizeof(Real)) {            \
+    if (avx2_) return NAME##_avx2<Avx2<Real>>(__VA_ARGS__); \
+  }                                                         \
+  return NAME##_portable<PortableLanes<Real, W>>(__VA_ARGS__)
+#else
+#define MSFEM_DISPATCH(NAME, ...) return NAME##_portable<PortableLanes<Real, W>>(__VA_ARGS__)
+#endif
+
+// The kernels for one precision and lane count, the instruction set chosen once.
+template <class Real, int W>
+class Kernels {
+ public:
+  Kernels() : avx2_(cpu_has_avx2()) {}
+
+  double explicit_step(bool damped, const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
+                       int begin, int end, Real h) const {
+    return damped ? explicit_step<true>(g, cur, next, begin, end, h)
+                  : explicit_step<false>(g, cur, next, begin, end, h);
+  }
+  void linearise(const NodeGatherLayout<Real, W>& g, const Real* records,
+                 ImplicitCoefficients<Real>& sys, const CgVectors<Real>& cg, int begin, int end,
+                 Real h) const {
+    MSFEM_DISPATCH(linearise_chunks, g, records, sys, cg, begin, end, h);
+  }
+  void cg_advance(const NodeGatherLayout<Real, W>& g, const CgVectors<Real>& cg, Real* records,
+                  Real* p_records, int begin, int end, Real h) const {
+    MSFEM_DISPATCH(cg_advance_chunks, g, cg, records, p_records, begin, end, h);
+  }
+  double product(const NodeGatherLayout<Real, W>& g, const ImplicitCoefficients<Real>& sys,
+                 const Real* p_records, Real* const (&p)[3], Real* const (&y)[3], int begin,
+                 int end) const {
+    MSFEM_DISPATCH(product_chunks, g, sys, p_records, p, y, begin, end);
+  }
+  void cg_start(const NodeGatherLayout<Real, W>& g, const ImplicitCoefficients<Real>& sys,
+                const CgVectors<Real>& cg, Real* p_records, int begin, int end,
+                double (&sums)[3]) const {
+    MSFEM_DISPATCH(cg_start_chunks, g, sys, cg, p_records, begin, end, sums);
+  }
+  void cg_update(const CgVectors<Real>& cg, Real step_length, int begin, int end,
+                 double (&sums)[3]) const {
+    MSFEM_DISPATCH(cg_update_chunks, cg, step_length, begin, end, sums);
+  }
+  void cg_direction(const NodeGatherLayout<Real, W>& g, const CgVectors<Real>& cg, Real* p_records,
+                    Real ratio, int begin, int end) const {
+    MSFEM_DISPATCH(cg_direction_chunks, g, cg, p_records, ratio, begin, end);
+  }
+
+ private:
+#if MSFEM_HAVE_X86_DISPATCH
+  template <class T>
+  using Avx2 = std::conditional_t<std::is_same_v<T, float>, Avx2Float, Avx2Double>;
+#endif
+  template <bool Damped>
+  double explicit_step(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next, int begin,
+                       int end, Real h) const {
+#if MSFEM_HAVE_X86_DISPATCH
+    if constexpr (W == 16) {
+      return explicit_chunks_avx512<Avx512Float, Damped>(g, cur, next, begin, end, h);
+    } else if constexpr (W == 32 / sizeof(Real)) {
+      if (avx2_) return explicit_chunks_avx2<Avx2<Real>, Damped>(g, cur, next, begin, end, h);
+    }
+#endif
+    return explicit_chunks_portable<PortableLanes<Real, W>, Damped>(g, cur, next, begin, end, h);
+  }
+
+  bool avx2_;
+};
+
+#undef MSFEM_DISPATCH
+
+}  // namespace msfem::massspring::detail
