@@ -173,8 +173,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::AlignedArray<Real> records_;    // x, v per node
   detail::AlignedArray<Real> p_records_;  // CG direction per node (zero on constrained nodes)
   detail::ImplicitCoefficients<Real> system_;
-  std::vector<Real> dv_[3], residual_[3], direction_[3], product_[3];  // product_ also holds z
-  std::vector<Real> inverse_block_[6];
+  detail::AlignedVector<Real> dv_[3], residual_[3], direction_[3], product_[3];  // product_: z too
+  detail::AlignedVector<Real> inverse_block_[6];
   detail::CgVectors<Real> cg_;
   std::vector<int> chunk_begin_;
   double partial_[2][3 * 64] = {};

@@ -50,15 +50,40 @@ class AlignedArray {
   std::size_t size_;
 };
 
+// Vectors whose data start on a cache line: the kernels' full-width vector loads and stores of
+// per-slot and per-lane arrays then never straddle two lines.
+template <class T>
+struct CacheLineAllocator {
+  using value_type = T;
+  CacheLineAllocator() = default;
+  template <class U>
+  CacheLineAllocator(const CacheLineAllocator<U>&) {}
+  T* allocate(std::size_t n) {
+    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64)));
+  }
+  void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
+  template <class U>
+  bool operator==(const CacheLineAllocator<U>&) const {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const CacheLineAllocator<U>&) const {
+    return false;
+  }
+};
+template <class T>
+using AlignedVector = std::vector<T, CacheLineAllocator<T>>;
+
 template <class Real, int W>
 struct NodeGatherLayout {
   int num_chunks = 0;
   int idle_record = 0, far_record = 0;  // num_nodes, num_nodes + 1
-  std::vector<int> lane_node;           // chunk * W + lane -> SoA node (idle_record when empty)
+  AlignedVector<int> lane_node;         // chunk * W + lane -> SoA node (idle_record when empty)
   std::vector<int> chunk_slot, chunk_width;
-  std::vector<int> neighbour, slot_spring;  // per slot; slot_spring -1 for padding
-  std::vector<Real> k, k_l0, c;             // per slot
-  std::vector<Real> mass, inverse_mass, damping, anchor, load[3];  // per lane (idle: mass 1)
+  AlignedVector<int> neighbour;                                      // per slot
+  std::vector<int> slot_spring;                                      // per slot; -1: padding
+  AlignedVector<Real> k, k_l0, c;                                    // per slot
+  AlignedVector<Real> mass, inverse_mass, damping, anchor, load[3];  // per lane (idle: mass 1)
   std::vector<int> block_begin;  // chunk ranges handed out to the threads
 
   explicit NodeGatherLayout(const SoaLayout<Real>& soa) {
@@ -147,8 +172,8 @@ struct NodeGatherLayout {
 // and the right-hand side.
 template <class Real>
 struct ImplicitCoefficients {
-  std::vector<Real> slot_terms;   // 4 per slot
-  std::vector<Real> own, rhs[3];  // per lane
+  AlignedVector<Real> slot_terms;   // 4 per slot
+  AlignedVector<Real> own, rhs[3];  // per lane
 
   void resize(std::size_t slots, std::size_t lanes) {
     slot_terms.assign(4 * slots, Real(0));

@@ -120,6 +120,27 @@ TEST(FastImplicitStepper, MatchesBackwardEuler) {
   EXPECT_LE(haptic.last_cg_iterations(), 50);
 }
 
+// The haptic default (relative residual 1e-2, warm start) against a tight solve of the same
+// backward-Euler steps: over 100 steps of 1 ms the positions stay within 2e-3 of the displacement
+// (measured: 8e-4 at most, in double and float alike), and no step reaches the iteration cap.
+TEST(FastImplicitStepper, HapticToleranceStaysCloseToTheTightSolve) {
+  const MassSpringModel model = loaded_three_tier();
+  FastImplicitStepper tight(model, FastImplicitOptions{2, true, 1e-12, 2000});
+  for (const bool single_precision : {false, true}) {
+    FastImplicitOptions haptic;
+    haptic.single_precision = single_precision;
+    FastImplicitStepper fast(model, haptic);
+    tight.set_state(initial_state(model));
+    for (int n = 0; n < 100; ++n) {
+      tight.step(1e-3);
+      fast.step(1e-3);
+      ASSERT_LT(fast.last_cg_iterations(), haptic.cg_max_iterations) << n;
+    }
+    EXPECT_LE(relative_difference(fast.state(), tight.state(), model.rest_state()), 2e-3)
+        << single_precision;
+  }
+}
+
 TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   const MassSpringModel model = loaded_three_tier();
   SteppingBenchmarkOptions options;

@@ -34,14 +34,14 @@ class NaiveAosStepper {
 
 struct SteppingBenchmarkOptions {
   int threads = 2;
-  bool single_precision = false;
+  bool single_precision = false;    ///< float for the explicit and the implicit fast stepper
   int steps_per_call = 10;          ///< explicit steps per FastExplicitStepper::step call
   double seconds_per_sample = 0.2;  ///< each sample runs at least this long
   int samples = 5;                  ///< the median is reported
   bool run_naive = true;
   bool run_implicit = true;
-  double implicit_dt = 1e-3;  ///< haptic rate
-  double implicit_cg_tolerance = 1e-3;
+  double implicit_dt = 1e-3;            ///< haptic rate
+  double implicit_cg_tolerance = 1e-2;  ///< FastImplicitOptions' haptic default
   int implicit_cg_max_iterations = 50;
 };
 
