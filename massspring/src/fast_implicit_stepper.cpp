@@ -38,7 +38,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         soa_(model, options.reorder_nodes, team_.size()),
         gather_(soa_),
         records_(kRecord * (soa_.num_nodes + 2)),
-        p_records_(kRecord * (soa_.num_nodes + 2)) {
+        p_records_(detail::kDirection * (soa_.num_nodes + 2)) {
     const std::size_t lanes = gather_.lane_node.size();
     system_.resize(gather_.chunk_slot.back(), lanes);
     for (int c = 0; c < 3; ++c)
@@ -144,12 +144,12 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     parity_[member] ^= 1;
   }
 
+  // The node records from the layout's arrays. The direction records keep Δv for the next warm
+  // start (zero at construction, as Δv is).
   void pack() {
-    for (auto* buffer : {&records_, &p_records_}) {
-      std::fill(buffer->data(), buffer->data() + buffer->size(), Real(0));
-      for (int c = 0; c < 3; ++c)
-        (*buffer)[kRecord * gather_.far_record + c] = Real(1e15);
-    }
+    std::fill(records_.data(), records_.data() + records_.size(), Real(0));
+    for (int c = 0; c < 3; ++c)
+      records_[kRecord * gather_.far_record + c] = Real(1e15);
     for (int i = 0; i < soa_.num_nodes; ++i)
       for (int c = 0; c < 3; ++c) {
         records_[kRecord * i + c] = soa_.x[c][i];

@@ -80,11 +80,18 @@ struct PortableLanes {
       total += a.v[l];
     return total;
   }
-  template <bool WithVelocity>
+  template <bool WithVelocity, int Stride = kRecord>
   static MSFEM_INLINE void load_records(const R* base, const int* index, V (&out)[6]) {
     for (int q = 0; q < (WithVelocity ? 6 : 3); ++q)
       for (int l = 0; l < N; ++l)
-        out[q].v[l] = base[kRecord * index[l] + q];
+        out[q].v[l] = base[Stride * index[l] + q];
+  }
+  static MSFEM_INLINE void store_directions(R* base, const int* index, const V (&in)[3]) {
+    for (int l = 0; l < N; ++l) {
+      for (int q = 0; q < 3; ++q)
+        base[kDirection * index[l] + q] = in[q].v[l];
+      base[kDirection * index[l] + 3] = R(0);
+    }
   }
   static MSFEM_INLINE void store_records(R* base, const int* index, const V (&in)[6]) {
     for (int l = 0; l < N; ++l)

@@ -50,13 +50,13 @@ struct Avx2Float {
   }
 
   // Record l in the low 128-bit half, record l + 4 in the high half; 4x4 transposes per half.
-  template <bool WithVelocity>
+  template <bool WithVelocity, int Stride = kRecord>
   MSFEM_TARGET_AVX2 static MSFEM_INLINE void load_records(const float* base, const int* index,
                                                           V (&out)[6]) {
     V r[4];
     for (int l = 0; l < 4; ++l)
-      r[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(base + kRecord * index[l])),
-                                  _mm_load_ps(base + kRecord * index[l + 4]), 1);
+      r[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(base + Stride * index[l])),
+                                  _mm_load_ps(base + Stride * index[l + 4]), 1);
     const V t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
     const V t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
     out[0] = _mm256_shuffle_ps(t0, t2, 0x44);
@@ -89,6 +89,19 @@ struct Avx2Float {
       _mm256_store_ps(base + kRecord * index[l + 4], _mm256_permute2f128_ps(r[l], q[l], 0x31));
     }
   }
+  // x y z of eight lanes into records of kDirection floats (x y z 0).
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store_directions(float* base, const int* index,
+                                                              const V (&in)[3]) {
+    const V zero = _mm256_setzero_ps();
+    const V t0 = _mm256_unpacklo_ps(in[0], in[1]), t1 = _mm256_unpackhi_ps(in[0], in[1]);
+    const V t2 = _mm256_unpacklo_ps(in[2], zero), t3 = _mm256_unpackhi_ps(in[2], zero);
+    const V r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
+                    _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
+    for (int l = 0; l < 4; ++l) {
+      _mm_store_ps(base + kDirection * index[l], _mm256_castps256_ps128(r[l]));
+      _mm_store_ps(base + kDirection * index[l + 4], _mm256_extractf128_ps(r[l], 1));
+    }
+  }
 };
 
 struct Avx2Double {
@@ -119,12 +132,12 @@ struct Avx2Double {
   }
 
   // One 64-byte record per node: (x y z vx) is one load, (vy vz) half of one.
-  template <bool WithVelocity>
+  template <bool WithVelocity, int Stride = kRecord>
   MSFEM_TARGET_AVX2 static MSFEM_INLINE void load_records(const double* base, const int* index,
                                                           V (&out)[6]) {
     V r[4];
     for (int l = 0; l < 4; ++l)
-      r[l] = _mm256_load_pd(base + kRecord * index[l]);
+      r[l] = _mm256_load_pd(base + Stride * index[l]);
     const V t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
     const V t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
     out[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
@@ -155,6 +168,16 @@ struct Avx2Double {
     _mm_store_pd(base + kRecord * index[1] + 4, _mm256_castpd256_pd128(u1));
     _mm_store_pd(base + kRecord * index[2] + 4, _mm256_extractf128_pd(u0, 1));
     _mm_store_pd(base + kRecord * index[3] + 4, _mm256_extractf128_pd(u1, 1));
+  }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store_directions(double* base, const int* index,
+                                                              const V (&in)[3]) {
+    const V zero = _mm256_setzero_pd();
+    const V t0 = _mm256_unpacklo_pd(in[0], in[1]), t1 = _mm256_unpackhi_pd(in[0], in[1]);
+    const V t2 = _mm256_unpacklo_pd(in[2], zero), t3 = _mm256_unpackhi_pd(in[2], zero);
+    _mm256_store_pd(base + kDirection * index[0], _mm256_permute2f128_pd(t0, t2, 0x20));
+    _mm256_store_pd(base + kDirection * index[1], _mm256_permute2f128_pd(t1, t3, 0x20));
+    _mm256_store_pd(base + kDirection * index[2], _mm256_permute2f128_pd(t0, t2, 0x31));
+    _mm256_store_pd(base + kDirection * index[3], _mm256_permute2f128_pd(t1, t3, 0x31));
   }
 };
 
@@ -193,19 +216,20 @@ struct Avx512Float {
   }
 
   // Records l, l + 4, l + 8, l + 12 in the four 128-bit quarters; 4x4 transposes per quarter.
+  template <int Stride>
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V quarters(const float* base, const int* index, int l,
                                                      int offset) {
-    V r = _mm512_castps128_ps512(_mm_load_ps(base + kRecord * index[l] + offset));
-    r = _mm512_insertf32x4(r, _mm_load_ps(base + kRecord * index[l + 4] + offset), 1);
-    r = _mm512_insertf32x4(r, _mm_load_ps(base + kRecord * index[l + 8] + offset), 2);
-    return _mm512_insertf32x4(r, _mm_load_ps(base + kRecord * index[l + 12] + offset), 3);
+    V r = _mm512_castps128_ps512(_mm_load_ps(base + Stride * index[l] + offset));
+    r = _mm512_insertf32x4(r, _mm_load_ps(base + Stride * index[l + 4] + offset), 1);
+    r = _mm512_insertf32x4(r, _mm_load_ps(base + Stride * index[l + 8] + offset), 2);
+    return _mm512_insertf32x4(r, _mm_load_ps(base + Stride * index[l + 12] + offset), 3);
   }
-  template <bool WithVelocity>
+  template <bool WithVelocity, int Stride = kRecord>
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void load_records(const float* base, const int* index,
                                                             V (&out)[6]) {
     V r[4];
     for (int l = 0; l < 4; ++l)
-      r[l] = quarters(base, index, l, 0);
+      r[l] = quarters<Stride>(base, index, l, 0);
     const V t0 = _mm512_unpacklo_ps(r[0], r[1]), t1 = _mm512_unpackhi_ps(r[0], r[1]);
     const V t2 = _mm512_unpacklo_ps(r[2], r[3]), t3 = _mm512_unpackhi_ps(r[2], r[3]);
     out[0] = _mm512_shuffle_ps(t0, t2, 0x44);
@@ -215,7 +239,7 @@ struct Avx512Float {
       out[3] = _mm512_shuffle_ps(t1, t3, 0xEE);
       V s[4];
       for (int l = 0; l < 4; ++l)
-        s[l] = quarters(base, index, l, 4);
+        s[l] = quarters<Stride>(base, index, l, 4);
       const V u0 = _mm512_unpacklo_ps(s[0], s[1]), u2 = _mm512_unpacklo_ps(s[2], s[3]);
       out[4] = _mm512_shuffle_ps(u0, u2, 0x44);
       out[5] = _mm512_shuffle_ps(u0, u2, 0xEE);
@@ -244,6 +268,20 @@ struct Avx512Float {
       float* record3 = base + kRecord * index[l + 12];
       _mm_store_ps(record3, _mm512_extractf32x4_ps(r[l], 3));
       _mm_store_ps(record3 + 4, _mm512_extractf32x4_ps(q[l], 3));
+    }
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store_directions(float* base, const int* index,
+                                                                const V (&in)[3]) {
+    const V zero = _mm512_setzero_ps();
+    const V t0 = _mm512_unpacklo_ps(in[0], in[1]), t1 = _mm512_unpackhi_ps(in[0], in[1]);
+    const V t2 = _mm512_unpacklo_ps(in[2], zero), t3 = _mm512_unpackhi_ps(in[2], zero);
+    const V r[4] = {_mm512_shuffle_ps(t0, t2, 0x44), _mm512_shuffle_ps(t0, t2, 0xEE),
+                    _mm512_shuffle_ps(t1, t3, 0x44), _mm512_shuffle_ps(t1, t3, 0xEE)};
+    for (int l = 0; l < 4; ++l) {
+      _mm_store_ps(base + kDirection * index[l], _mm512_castps512_ps128(r[l]));
+      _mm_store_ps(base + kDirection * index[l + 4], _mm512_extractf32x4_ps(r[l], 1));
+      _mm_store_ps(base + kDirection * index[l + 8], _mm512_extractf32x4_ps(r[l], 2));
+      _mm_store_ps(base + kDirection * index[l + 12], _mm512_extractf32x4_ps(r[l], 3));
     }
   }
 };

@@ -27,6 +27,9 @@
 namespace msfem::massspring::detail {
 
 constexpr int kRecord = 8;
+// CG direction records of the implicit stepper: x y z and a pad slot, half a node record, so that
+// the direction the products gather from stays in the per-core cache.
+constexpr int kDirection = 4;
 constexpr int kSortWindow = 64;
 constexpr int kBlockSlots = 4096;
 
