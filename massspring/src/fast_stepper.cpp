@@ -71,7 +71,6 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     check_time_step(dt);
     const Real h = static_cast<Real>(dt);
     std::vector<double> check(team_.size(), 0.0);
-    const bool damped = soa_.has_spring_damping;
     // Blocks are taken from one ticket counter. In each step every member draws tickets until it
     // gets one past the step's blocks, so a step uses exactly blocks + members tickets and the
     // next step's tickets start at a known number without resetting the counter.
@@ -89,7 +88,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
              block < blocks;
              block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step) {
           const int begin = gather_.block_begin[block], end = gather_.block_begin[block + 1];
-          sum += kernels_.explicit_step(damped, gather_, cur, next, begin, end, h);
+          sum += kernels_.explicit_step(gather_, cur, next, begin, end, h);
         }
         from = 1 - from;
         if (n + 1 < count) team_.barrier();  // run() itself waits for the last step

@@ -65,6 +65,9 @@ struct PortableLanes {
   static MSFEM_INLINE V fnmadd(V a, V b, V c) {
     return map([&](int l) { return c.v[l] - a.v[l] * b.v[l]; });
   }
+  static MSFEM_INLINE V where_positive(V a, V b) {
+    return map([&](int l) { return a.v[l] > R(0) ? b.v[l] : R(0); });
+  }
   static MSFEM_INLINE V div(V a, V b) {
     return map([&](int l) { return a.v[l] / b.v[l]; });
   }
@@ -158,10 +161,16 @@ class Kernels {
  public:
   Kernels() : avx2_(cpu_has_avx2()) {}
 
-  double explicit_step(bool damped, const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
-                       int begin, int end, Real h) const {
-    return damped ? explicit_step<true>(g, cur, next, begin, end, h)
-                  : explicit_step<false>(g, cur, next, begin, end, h);
+  double explicit_step(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next, int begin,
+                       int end, Real h) const {
+    switch (g.spring_damping) {
+      case SpringDamping::none:
+        return explicit_step_for<SpringDamping::none>(g, cur, next, begin, end, h);
+      case SpringDamping::uniform:
+        return explicit_step_for<SpringDamping::uniform>(g, cur, next, begin, end, h);
+      default:
+        return explicit_step_for<SpringDamping::per_spring>(g, cur, next, begin, end, h);
+    }
   }
   void linearise(const NodeGatherLayout<Real, W>& g, const Real* records,
                  ImplicitCoefficients<Real>& sys, const CgVectors<Real>& cg, int begin, int end,
@@ -196,9 +205,9 @@ class Kernels {
   template <class T>
   using Avx2 = std::conditional_t<std::is_same_v<T, float>, Avx2Float, Avx2Double>;
 #endif
-  template <bool Damped>
-  double explicit_step(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next, int begin,
-                       int end, Real h) const {
+  template <SpringDamping Damped>
+  double explicit_step_for(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
+                           int begin, int end, Real h) const {
 #if MSFEM_HAVE_X86_DISPATCH
     if constexpr (W == 16) {
       return explicit_chunks_avx512<Avx512Float, Damped>(g, cur, next, begin, end, h);

@@ -26,6 +26,10 @@ struct Avx2Float {
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V max(V a, V b) { return _mm256_max_ps(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sqrt(V a) { return _mm256_sqrt_ps(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V div(V a, V b) { return _mm256_div_ps(a, b); }
+  // b where a > 0, else 0
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V where_positive(V a, V b) {
+    return _mm256_and_ps(_mm256_cmp_ps(a, _mm256_setzero_ps(), _CMP_GT_OQ), b);
+  }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V set1(float a) { return _mm256_set1_ps(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V add(V a, V b) { return _mm256_add_ps(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sub(V a, V b) { return _mm256_sub_ps(a, b); }
@@ -113,6 +117,9 @@ struct Avx2Double {
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V max(V a, V b) { return _mm256_max_pd(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sqrt(V a) { return _mm256_sqrt_pd(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V div(V a, V b) { return _mm256_div_pd(a, b); }
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V where_positive(V a, V b) {
+    return _mm256_and_pd(_mm256_cmp_pd(a, _mm256_setzero_pd(), _CMP_GT_OQ), b);
+  }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V set1(double a) { return _mm256_set1_pd(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V add(V a, V b) { return _mm256_add_pd(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sub(V a, V b) { return _mm256_sub_pd(a, b); }
@@ -190,6 +197,9 @@ struct Avx512Float {
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V max(V a, V b) { return _mm512_max_ps(a, b); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V sqrt(V a) { return _mm512_sqrt_ps(a); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V div(V a, V b) { return _mm512_div_ps(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V where_positive(V a, V b) {
+    return _mm512_maskz_mov_ps(_mm512_cmp_ps_mask(a, _mm512_setzero_ps(), _CMP_GT_OQ), b);
+  }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V set1(float a) { return _mm512_set1_ps(a); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V add(V a, V b) { return _mm512_add_ps(a, b); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V sub(V a, V b) { return _mm512_sub_ps(a, b); }

@@ -77,15 +77,19 @@ struct CacheLineAllocator {
 template <class T>
 using AlignedVector = std::vector<T, CacheLineAllocator<T>>;
 
+enum class SpringDamping { none, uniform, per_spring };
+
 template <class Real, int W>
 struct NodeGatherLayout {
   int num_chunks = 0;
   int idle_record = 0, far_record = 0;  // num_nodes, num_nodes + 1
   AlignedVector<int> lane_node;         // chunk * W + lane -> SoA node (idle_record when empty)
   std::vector<int> chunk_slot, chunk_width;
-  AlignedVector<int> neighbour;                                      // per slot
-  std::vector<int> slot_spring;                                      // per slot; -1: padding
-  AlignedVector<Real> k, k_l0, c;                                    // per slot
+  AlignedVector<int> neighbour;    // per slot
+  std::vector<int> slot_spring;    // per slot; -1: padding
+  AlignedVector<Real> k, k_l0, c;  // per slot
+  SpringDamping spring_damping = SpringDamping::none;
+  Real uniform_c = 0;  // every spring's c when spring_damping == uniform
   AlignedVector<Real> mass, inverse_mass, damping, anchor, load[3];  // per lane (idle: mass 1)
   std::vector<int> block_begin;  // chunk ranges handed out to the threads
 
@@ -138,6 +142,15 @@ struct NodeGatherLayout {
 
   // Copies the per-spring and per-node constants of the SoA layout into slot and lane order.
   void load_parameters(const SoaLayout<Real>& soa) {
+    spring_damping = SpringDamping::none;
+    uniform_c = soa.num_springs > 0 ? soa.damping[0] : Real(0);
+    for (int s = 0; s < soa.num_springs; ++s)  // uniform: padding told apart by k = 0
+      if (soa.damping[s] != uniform_c || !(soa.stiffness[s] > Real(0)))
+        spring_damping = SpringDamping::per_spring;
+    if (spring_damping == SpringDamping::none && uniform_c != Real(0))
+      spring_damping = SpringDamping::uniform;
+    else if (spring_damping == SpringDamping::per_spring && !soa.has_spring_damping)
+      spring_damping = SpringDamping::none;
     for (std::size_t slot = 0; slot < slot_spring.size(); ++slot) {
       const int s = slot_spring[slot];
       if (s < 0) continue;
