@@ -188,7 +188,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
                                          const FastImplicitOptions& options) {
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
-  if (options.single_precision && detail::preferred_lanes<float>(true) == 16)
+  if (options.single_precision &&
+      detail::preferred_lanes<float>(true, model.network().num_springs(), model.num_nodes()) == 16)
     impl_ = std::make_unique<GatherImplicitStepper<float, 16>>(model, options);
   else if (options.single_precision)
     impl_ = std::make_unique<GatherImplicitStepper<float, 8>>(model, options);

@@ -158,7 +158,9 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
 FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
                                          const FastStepperOptions& options) {
-  if (options.single_precision && detail::preferred_lanes<float>(options.allow_avx512) == 16)
+  if (options.single_precision &&
+      detail::preferred_lanes<float>(options.allow_avx512, model.network().num_springs(),
+                                     model.num_nodes()) == 16)
     impl_ = std::make_unique<GatherExplicitStepper<float, 16>>(model, options);
   else if (options.single_precision)
     impl_ = std::make_unique<GatherExplicitStepper<float, 8>>(model, options);

@@ -136,11 +136,16 @@ inline bool cpu_has_avx512() {
 }
 #endif
 
-// Lanes per chunk for a precision: 16 floats where AVX-512 may be used, else one 256-bit vector.
+// Lanes per chunk for a precision and a model. Floats take 16 (AVX-512) only while the springs and
+// node records stay well inside one core complex's L3 (32 MB on the Zen machine; sysconf reports
+// the whole socket's, so a fixed bound): measured there, 16 lanes were ~15 % faster than 8 at brain
+// scale (5 MB) and ~15-20 % slower at 10x brain (47 MB), where the step streams from memory.
 template <class Real>
-int preferred_lanes(bool allow_avx512) {
-  if (std::is_same_v<Real, float>) return allow_avx512 && cpu_has_avx512() ? 16 : 8;
-  return 4;
+int preferred_lanes(bool allow_avx512, long springs, long nodes) {
+  if (!std::is_same_v<Real, float>) return 4;
+  constexpr long kCacheBytes = 24L << 20;
+  const long bytes = 2 * springs * 3 * static_cast<long>(sizeof(Real)) + 2 * nodes * 32;
+  return allow_avx512 && cpu_has_avx512() && bytes < kCacheBytes ? 16 : 8;
 }
 
 #if MSFEM_HAVE_X86_DISPATCH

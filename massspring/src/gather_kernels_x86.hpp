@@ -226,6 +226,9 @@ struct Avx512Float {
   }
 
   // Records l, l + 4, l + 8, l + 12 in the four 128-bit quarters; 4x4 transposes per quarter.
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE __m256 upper_half(V a) {
+    return _mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(a), 1));
+  }
   template <int Stride>
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V quarters(const float* base, const int* index, int l,
                                                      int offset) {
@@ -265,19 +268,16 @@ struct Avx512Float {
                     _mm512_shuffle_ps(t1, t3, 0x44), _mm512_shuffle_ps(t1, t3, 0xEE)};
     const V q[4] = {_mm512_shuffle_ps(u0, zero, 0x44), _mm512_shuffle_ps(u0, zero, 0xEE),
                     _mm512_shuffle_ps(u1, zero, 0x44), _mm512_shuffle_ps(u1, zero, 0xEE)};
+    // Quarters k of r[l] and q[l] make record l + 4k: pair them up, one 32-byte store per record.
     for (int l = 0; l < 4; ++l) {
-      _mm_store_ps(base + kRecord * index[l], _mm512_castps512_ps128(r[l]));
-      _mm_store_ps(base + kRecord * index[l] + 4, _mm512_castps512_ps128(q[l]));
-      // The lane index must be an immediate: at -O2 GCC does not unroll a loop over it.
-      float* record1 = base + kRecord * index[l + 4];
-      _mm_store_ps(record1, _mm512_extractf32x4_ps(r[l], 1));
-      _mm_store_ps(record1 + 4, _mm512_extractf32x4_ps(q[l], 1));
-      float* record2 = base + kRecord * index[l + 8];
-      _mm_store_ps(record2, _mm512_extractf32x4_ps(r[l], 2));
-      _mm_store_ps(record2 + 4, _mm512_extractf32x4_ps(q[l], 2));
-      float* record3 = base + kRecord * index[l + 12];
-      _mm_store_ps(record3, _mm512_extractf32x4_ps(r[l], 3));
-      _mm_store_ps(record3 + 4, _mm512_extractf32x4_ps(q[l], 3));
+      const V low = _mm512_shuffle_f32x4(r[l], q[l], 0x44);   // r0 r1 q0 q1
+      const V high = _mm512_shuffle_f32x4(r[l], q[l], 0xEE);  // r2 r3 q2 q3
+      const V a = _mm512_shuffle_f32x4(low, low, 0xD8);       // r0 q0 r1 q1
+      const V b = _mm512_shuffle_f32x4(high, high, 0xD8);     // r2 q2 r3 q3
+      _mm256_store_ps(base + kRecord * index[l], _mm512_castps512_ps256(a));
+      _mm256_store_ps(base + kRecord * index[l + 4], upper_half(a));
+      _mm256_store_ps(base + kRecord * index[l + 8], _mm512_castps512_ps256(b));
+      _mm256_store_ps(base + kRecord * index[l + 12], upper_half(b));
     }
   }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void store_directions(float* base, const int* index,
