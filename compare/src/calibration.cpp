@@ -67,8 +67,13 @@ LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d
                           const Eigen::Vector3d& force) {
   LoadErrors e;
   e.load = reference.load.label();
-  const ErrorMetrics m =
-      displacement_error(displacement, reference.surface_displacement, reference.compared_vertices);
+  // tet_edges on the FEM's tool-refined mesh has more surface nodes; the case's come first.
+  const Eigen::Index n = reference.surface_displacement.rows();
+  if (displacement.rows() < n)
+    throw std::invalid_argument("displacement fields differ in size: " +
+                                std::to_string(displacement.rows()) + " vs " + std::to_string(n));
+  const ErrorMetrics m = displacement_error(displacement.topRows(n), reference.surface_displacement,
+                                            reference.compared_vertices);
   e.rel_l2_error = m.rel_l2_error;
   e.mean_error_over_max_disp = m.mean_error_over_max_disp;
   e.tool_force = force;
@@ -84,6 +89,7 @@ LoadModels models_for(const BuiltVariant& base, const Problem& problem,
     v.name = base.name;
     v.model = std::make_unique<ms::MassSpringModel>(*base.model);
     v.tool_patch = base.tool_patch;
+    v.case_surface_vertices = base.case_surface_vertices;
     set_tool_depth(v, problem, r.tool);
     m.variants.push_back(std::move(v));
     m.x.emplace_back();

@@ -1,5 +1,6 @@
 #include "msfem/compare/case_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -54,6 +55,18 @@ std::vector<double> curve_depths(const cases::ToolParameters& tool) {
   return {0.25 * tool.depth_m, 0.5 * tool.depth_m, 0.75 * tool.depth_m, tool.depth_m};
 }
 
+std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,
+                                           const std::optional<ToolPlacement>& tool) {
+  if (!tool || curve.size() < 2) return std::nullopt;
+  std::sort(curve.begin(), curve.end(),
+            [](const auto& a, const auto& b) { return a.depth_m < b.depth_m; });
+  for (std::size_t i = 1; i < curve.size(); ++i)
+    if (!(curve[i].force_n.dot(tool->outward_normal) >
+          curve[i - 1].force_n.dot(tool->outward_normal)))
+      return false;
+  return true;
+}
+
 CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& settings) {
   const auto start = Clock::now();
   const Progress progress(settings.quiet);
@@ -106,6 +119,8 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
                       {run.mesh, run.fem, run.fem_force_depth});
   }
 
+  run.fem_force_depth_monotone = force_grows_with_depth(run.fem_force_depth, tool);
+
   const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
   for (std::size_t v = 0; v < prescribed.size(); ++v)
     if (!prescribed[v]) run.compared_vertices.push_back(static_cast<int>(v));
@@ -123,7 +138,34 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     r.springs = built.model->network().num_springs();
     r.warnings = built.warnings;
     r.parameters = variant_parameters(*built.model);
-    const StaticSolution s = solve_variant_static(built);
+    StaticSolution s;
+    if (depths.empty()) {
+      s = solve_variant_static(built);
+    } else {
+      // A quasi-static loading path, each depth started from the last, as a tool pressed in steps
+      // is: a network with several equilibria (one that buckles under the tool) then stays on the
+      // branch a simulator would follow, and the curve is the force a haptic device would render.
+      std::vector<double> path = depths;
+      path.push_back(tool->depth);
+      std::sort(path.begin(), path.end());
+      path.erase(std::unique(path.begin(), path.end()), path.end());
+      Eigen::VectorXd x;
+      for (double depth : path) {
+        set_tool_depth(built, problem, at_depth(*tool, depth));
+        StaticSolution at = solve_variant_static(built, x);
+        x = at.x;
+        if (std::find(depths.begin(), depths.end(), depth) != depths.end())
+          r.force_depth.push_back({depth, at.tool_force});
+        if (depth == tool->depth) s = std::move(at);
+      }
+      set_tool_depth(built, problem, *tool);
+    }
+    r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
+    if (r.force_depth_monotone == false)
+      r.warnings.push_back(
+          "the reaction force does not grow with depth along the loading path: the network "
+          "buckles or snaps under the tool (a spring network has no resistance to inverted "
+          "elements), so its force-depth curve is not one a haptic device should render");
     r.newton_iterations = s.newton_iterations;
     r.surface_displacement = s.surface_displacement;
     r.error = s.surface_displacement - run.fem.surface_displacement;
@@ -137,14 +179,6 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
     r.volume_change = volume_change(problem.surface, s.surface_displacement);
     if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
-    for (double depth : depths) {
-      if (depth == tool->depth) {
-        r.force_depth.push_back({depth, s.tool_force});
-        continue;
-      }
-      set_tool_depth(built, problem, at_depth(*tool, depth));
-      r.force_depth.push_back({depth, solve_variant_static(built).tool_force});
-    }
     run.variants.push_back(std::move(r));
     progress.advance("variant " + name, i + 1, total, seconds_since(variants_start));
   }

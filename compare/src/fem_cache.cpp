@@ -12,7 +12,7 @@ namespace msfem::compare {
 namespace {
 
 // Bump when the FEM's formulation or the entry layout changes: old entries then miss.
-constexpr const char* cache_version = "msfem-fem-cache-3";
+constexpr const char* cache_version = "msfem-fem-cache-4";
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
   return {{"rows", m.rows()},
@@ -67,6 +67,8 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
   h.number(p.fem.cell_size_m);
   h.text(p.fem.solver);
   h.number(p.fem.relative_tolerance);
+  h.number(p.fem.refine_at_tool);
+  h.number(p.fem.tool_cell_size_m);
   for (double d : curve_depths)
     h.number(d);
   return h.hex();
@@ -87,7 +89,7 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     e.mesh.num_surface_vertices = j.at("num_surface_vertices");
     auto& s = e.solution;
     s.vertex_displacement = matrix_from(j.at("vertex_displacement"));
-    s.surface_displacement = s.vertex_displacement.topRows(e.mesh.num_surface_vertices);
+    s.surface_displacement = s.vertex_displacement.topRows(j.at("case_surface_vertices"));
     s.tool_force = vec_from(j.at("tool_force"));
     s.volume_change = j.at("volume_change");
     const auto& st = j.at("statistics");
@@ -122,6 +124,7 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                             {"mesh_tetrahedra", matrix_json(e.mesh.tetrahedra.cast<double>())},
                             {"num_surface_vertices", e.mesh.num_surface_vertices},
                             {"vertex_displacement", matrix_json(s.vertex_displacement)},
+                            {"case_surface_vertices", s.surface_displacement.rows()},
                             {"tool_force", vec(s.tool_force)},
                             {"volume_change", s.volume_change},
                             {"statistics",

@@ -1,8 +1,10 @@
 #include "msfem/compare/fem_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "msfem/cases/surface.hpp"
+#include "msfem/cases/surface_refinement.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
 #include "msfem/fem_reference/surface_mesher.hpp"
 
@@ -26,11 +28,25 @@ fem_reference::VolumeMesh mesh_problem(const Problem& problem,
   const double edge = mean_edge_length(problem.surface);
   options.cell_size = p.fem.cell_size_m > 0 ? p.fem.cell_size_m : edge;
   if (!refine_near && !problem.tools.empty()) refine_near = {problem.tools.front()};
-  for (const ToolPlacement& t : refine_near.value_or(std::vector<ToolPlacement>{}))
-    options.refinements.push_back(fem_reference::LocalRefinement{
-        t.contact_point, 2 * t.radius, 2 * t.radius, 0.5 * options.cell_size});
-  return fem_reference::mesh_closed_surface(problem.surface.vertices, problem.surface.triangles,
-                                            options);
+  const std::vector<ToolPlacement> tools = refine_near.value_or(std::vector<ToolPlacement>{});
+  cases::Surface surface = problem.surface;
+  double tool_cell = 0.5 * options.cell_size;
+  if (p.fem.refine_at_tool && !tools.empty()) {
+    // The refined surface keeps the case's vertices first, so mesh vertex i is still surface
+    // vertex i for every vertex the metrics compare.
+    std::vector<cases::RefinementBall> balls;
+    double radius = 0;
+    for (const ToolPlacement& t : tools) {
+      balls.push_back({t.contact_point, 2 * t.radius});
+      radius = std::max(radius, t.radius);
+    }
+    tool_cell = p.fem.tool_cell_size_m > 0 ? p.fem.tool_cell_size_m : radius / 3;
+    surface = cases::refine_near(problem.surface, balls, tool_cell).surface;
+  }
+  for (const ToolPlacement& t : tools)
+    options.refinements.push_back(
+        fem_reference::LocalRefinement{t.contact_point, 2 * t.radius, 2 * t.radius, tool_cell});
+  return fem_reference::mesh_closed_surface(surface.vertices, surface.triangles, options);
 }
 
 std::vector<bool> prescribed_surface_vertices(const Problem& problem,

@@ -17,6 +17,10 @@ nlohmann::json vec(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
 }
 
+nlohmann::json optional_json(const std::optional<bool>& b) {
+  return b ? nlohmann::json(*b) : nlohmann::json();
+}
+
 nlohmann::json zone(const ErrorMetrics& m) {
   return {
       {"rel_l2_error", m.rel_l2_error}, {"max_error_m", m.max_error_m}, {"vertices", m.vertices}};
@@ -77,6 +81,7 @@ nlohmann::json summary_json(const CaseRun& run) {
   for (const auto& pt : run.fem_force_depth)
     curve.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
   fem["force_depth"] = curve;
+  fem["force_depth_monotone"] = optional_json(run.fem_force_depth_monotone);
 
   nlohmann::json variants = nlohmann::json::array();
   for (const auto& v : run.variants) {
@@ -108,6 +113,7 @@ nlohmann::json summary_json(const CaseRun& run) {
                         {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
                         {"newton_iterations", v.newton_iterations},
                         {"force_depth", fd},
+                        {"force_depth_monotone", optional_json(v.force_depth_monotone)},
                         {"warnings", v.warnings},
                         {"parameters", v.parameters}});
   }

@@ -112,19 +112,20 @@ const std::vector<std::string>& known_variants() {
   return names;
 }
 
-void set_tool_depth(BuiltVariant& variant, const Problem& problem, const ToolPlacement& tool) {
+void set_tool_depth(BuiltVariant& variant, const Problem& /*problem*/, const ToolPlacement& tool) {
   const fem_reference::Support support = tool_patch_support(tool);
   ms::MassSpringModel& model = *variant.model;
   for (int node : variant.tool_patch)
     model.release_node(node);
   variant.tool_patch.clear();
-  // The very same patch and displacement as the FEM's tool support, node for node.
-  const auto& surface_nodes = model.network().surface_nodes;
-  for (Eigen::Index v = 0; v < problem.surface.num_vertices(); ++v) {
-    const Eigen::Vector3d x = problem.surface.vertices.row(v).transpose();
+  // The very same patch and displacement as the FEM's tool support, node for node: the case's
+  // surface vertices, and tet_edges' extra surface nodes where it shares the FEM's refined mesh.
+  const auto& network = model.network();
+  for (const int node : network.surface_nodes) {
+    const Eigen::Vector3d x = network.rest_positions.row(node).transpose();
     if (!support.region(x)) continue;
-    model.prescribe_displacement(surface_nodes[v], support.displacement(x));
-    variant.tool_patch.push_back(surface_nodes[v]);
+    model.prescribe_displacement(node, support.displacement(x));
+    variant.tool_patch.push_back(node);
   }
   // Supports win over the tool where both catch a node (as in the FEM, where the fixed region is
   // listed after the tool but a tool on a fixed node is refused by make_problem).
@@ -136,6 +137,7 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
   const auto& p = problem.parameters;
   BuiltVariant variant;
   variant.name = name;
+  variant.case_surface_vertices = problem.surface.num_vertices();
   try {
     ms::SpringNetwork network = build_network(name, problem, mesh);
     variant.warnings = network.warnings;
@@ -180,7 +182,8 @@ StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::Ve
                              std::to_string(r.residual_norm) + " N)");
   solution.x = r.x;
   solution.newton_iterations = r.iterations;
-  solution.surface_displacement = model.surface_displacement(r.x);
+  solution.surface_displacement =
+      model.surface_displacement(r.x).topRows(variant.case_surface_vertices);
   if (!variant.tool_patch.empty())
     solution.tool_force = ms::patch_reaction_force(model, r.x, variant.tool_patch);
   return solution;

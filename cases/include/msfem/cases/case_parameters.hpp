@@ -91,6 +91,10 @@ struct FemParameters {
   double cell_size_m = 0.0;        ///< 0: from the surface's mean edge length
   std::string solver = "cg_gamg";  ///< cg_gamg | cg_boomeramg | mumps
   double relative_tolerance = 1e-10;
+  /// Refine the FEM's surface (and volume) within 2 r of each tool, so the reference resolves the
+  /// contact patch however coarse the case's surface is.
+  bool refine_at_tool = true;
+  double tool_cell_size_m = 0.0;  ///< edge length there; 0: the tool radius / 3
 };
 
 struct TimingParameters {

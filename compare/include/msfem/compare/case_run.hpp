@@ -48,6 +48,7 @@ struct VariantResult {
   Eigen::MatrixX3d surface_displacement;  ///< at the surface vertices, m
   Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
   std::vector<ForceDepthPoint> force_depth;
+  std::optional<bool> force_depth_monotone;  ///< none without a curve
 };
 
 struct CaseRun {
@@ -55,6 +56,7 @@ struct CaseRun {
   fem_reference::VolumeMesh mesh;
   FemSolution fem;
   std::vector<ForceDepthPoint> fem_force_depth;
+  std::optional<bool> fem_force_depth_monotone;
   std::vector<VariantResult> variants;
   std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
   double wall_time_s = 0.0;
@@ -76,5 +78,11 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 
 /// Force-depth depths of a tool: the case's list, or a quarter, half, three quarters and all of it.
 std::vector<double> curve_depths(const cases::ToolParameters& tool);
+
+/// Whether the force the tissue exerts on the tool, along the tool's outward normal, grows strictly
+/// from each depth of the curve to the next deeper one; none without a tool or with fewer than
+/// two points.
+std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,
+                                           const std::optional<ToolPlacement>& tool);
 
 }  // namespace msfem::compare

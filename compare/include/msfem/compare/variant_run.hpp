@@ -25,6 +25,9 @@ struct BuiltVariant {
   std::string name;
   std::unique_ptr<massspring::MassSpringModel> model;
   std::vector<int> tool_patch;  ///< nodes the tool prescribes
+  /// The case's surface vertices are the first this many surface nodes (tet_edges on the FEM's
+  /// mesh refined at the tool has more; only these are compared).
+  Eigen::Index case_surface_vertices = 0;
   std::vector<std::string> warnings;
 };
 BuiltVariant build_variant(const std::string& name, const Problem& problem,
