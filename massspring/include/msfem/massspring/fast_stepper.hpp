@@ -25,10 +25,11 @@ struct FastStepperOptions {
 /// gathers its own springs' forces from its neighbours' records of the previous step and writes its
 /// new x and v to a second buffer (double buffering), so a step has no scatter, no force buffers to
 /// sum and one barrier. Springs are stored per node in vector-width chunks (sliced ELLPACK) with
-/// their k, k l0 and c beside the neighbour index. Each spring is evaluated twice, once per end:
-/// more arithmetic for far less memory traffic. Threads take contiguous shares of the chunks on a
-/// persistent team; the kernels are compiled for baseline x86-64 and for AVX2+FMA (float: eight
-/// lanes with register transposes of the records) and picked at run time.
+/// their k and k l0 (and c, unless one damping serves all springs) beside the neighbour index. Each
+/// spring is evaluated twice, once per end: more arithmetic for far less memory traffic. Threads
+/// take blocks of chunks from a shared counter, so a thread the OS pre-empts delays a step by one
+/// block. The kernels (gather_kernels.hpp) are compiled for baseline x86-64, AVX2+FMA (float 8
+/// lanes, double 4) and AVX-512 (float 16, while the model fits in cache) and picked at run time.
 class FastExplicitStepper {
  public:
   explicit FastExplicitStepper(const MassSpringModel& model,
