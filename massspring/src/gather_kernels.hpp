@@ -87,19 +87,19 @@ struct PortableLanes {
   static MSFEM_INLINE void load_records(const R* base, const int* index, V (&out)[6]) {
     for (int q = 0; q < (WithVelocity ? 6 : 3); ++q)
       for (int l = 0; l < N; ++l)
-        out[q].v[l] = base[Stride * index[l] + q];
+        out[q].v[l] = record_at<Stride>(base, index[l])[q];
   }
   static MSFEM_INLINE void store_directions(R* base, const int* index, const V (&in)[3]) {
     for (int l = 0; l < N; ++l) {
       for (int q = 0; q < 3; ++q)
-        base[kDirection * index[l] + q] = in[q].v[l];
-      base[kDirection * index[l] + 3] = R(0);
+        record_at<kDirection>(base, index[l])[q] = in[q].v[l];
+      record_at<kDirection>(base, index[l])[3] = R(0);
     }
   }
   static MSFEM_INLINE void store_records(R* base, const int* index, const V (&in)[6]) {
     for (int l = 0; l < N; ++l)
       for (int q = 0; q < 6; ++q)
-        base[kRecord * index[l] + q] = in[q].v[l];
+        record_at(base, index[l])[q] = in[q].v[l];
   }
 };
 

@@ -59,8 +59,9 @@ struct Avx2Float {
                                                           V (&out)[6]) {
     V r[4];
     for (int l = 0; l < 4; ++l)
-      r[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(base + Stride * index[l])),
-                                  _mm_load_ps(base + Stride * index[l + 4]), 1);
+      r[l] = _mm256_insertf128_ps(
+          _mm256_castps128_ps256(_mm_load_ps(record_at<Stride>(base, index[l]))),
+          _mm_load_ps(record_at<Stride>(base, index[l + 4])), 1);
     const V t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
     const V t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
     out[0] = _mm256_shuffle_ps(t0, t2, 0x44);
@@ -71,8 +72,8 @@ struct Avx2Float {
       V s[4];
       for (int l = 0; l < 4; ++l)
         s[l] =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(base + kRecord * index[l] + 4)),
-                                 _mm_load_ps(base + kRecord * index[l + 4] + 4), 1);
+            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(record_at(base, index[l]) + 4)),
+                                 _mm_load_ps(record_at(base, index[l + 4]) + 4), 1);
       const V u0 = _mm256_unpacklo_ps(s[0], s[1]), u2 = _mm256_unpacklo_ps(s[2], s[3]);
       out[4] = _mm256_shuffle_ps(u0, u2, 0x44);
       out[5] = _mm256_shuffle_ps(u0, u2, 0xEE);
@@ -89,8 +90,8 @@ struct Avx2Float {
     const V q[4] = {_mm256_shuffle_ps(u0, zero, 0x44), _mm256_shuffle_ps(u0, zero, 0xEE),
                     _mm256_shuffle_ps(u1, zero, 0x44), _mm256_shuffle_ps(u1, zero, 0xEE)};
     for (int l = 0; l < 4; ++l) {
-      _mm256_store_ps(base + kRecord * index[l], _mm256_permute2f128_ps(r[l], q[l], 0x20));
-      _mm256_store_ps(base + kRecord * index[l + 4], _mm256_permute2f128_ps(r[l], q[l], 0x31));
+      _mm256_store_ps(record_at(base, index[l]), _mm256_permute2f128_ps(r[l], q[l], 0x20));
+      _mm256_store_ps(record_at(base, index[l + 4]), _mm256_permute2f128_ps(r[l], q[l], 0x31));
     }
   }
   // x y z of eight lanes into records of kDirection floats (x y z 0).
@@ -102,8 +103,8 @@ struct Avx2Float {
     const V r[4] = {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xEE),
                     _mm256_shuffle_ps(t1, t3, 0x44), _mm256_shuffle_ps(t1, t3, 0xEE)};
     for (int l = 0; l < 4; ++l) {
-      _mm_store_ps(base + kDirection * index[l], _mm256_castps256_ps128(r[l]));
-      _mm_store_ps(base + kDirection * index[l + 4], _mm256_extractf128_ps(r[l], 1));
+      _mm_store_ps(record_at<kDirection>(base, index[l]), _mm256_castps256_ps128(r[l]));
+      _mm_store_ps(record_at<kDirection>(base, index[l + 4]), _mm256_extractf128_ps(r[l], 1));
     }
   }
 };
@@ -144,7 +145,7 @@ struct Avx2Double {
                                                           V (&out)[6]) {
     V r[4];
     for (int l = 0; l < 4; ++l)
-      r[l] = _mm256_load_pd(base + Stride * index[l]);
+      r[l] = _mm256_load_pd(record_at<Stride>(base, index[l]));
     const V t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
     const V t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
     out[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
@@ -153,11 +154,11 @@ struct Avx2Double {
     if constexpr (WithVelocity) {
       out[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
       const V a =
-          _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_pd(base + kRecord * index[0] + 4)),
-                               _mm_load_pd(base + kRecord * index[2] + 4), 1);
+          _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_pd(record_at(base, index[0]) + 4)),
+                               _mm_load_pd(record_at(base, index[2]) + 4), 1);
       const V b =
-          _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_pd(base + kRecord * index[1] + 4)),
-                               _mm_load_pd(base + kRecord * index[3] + 4), 1);
+          _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_load_pd(record_at(base, index[1]) + 4)),
+                               _mm_load_pd(record_at(base, index[3]) + 4), 1);
       out[4] = _mm256_unpacklo_pd(a, b);
       out[5] = _mm256_unpackhi_pd(a, b);
     }
@@ -167,24 +168,24 @@ struct Avx2Double {
     const V t0 = _mm256_unpacklo_pd(in[0], in[1]), t1 = _mm256_unpackhi_pd(in[0], in[1]);
     const V t2 = _mm256_unpacklo_pd(in[2], in[3]), t3 = _mm256_unpackhi_pd(in[2], in[3]);
     const V u0 = _mm256_unpacklo_pd(in[4], in[5]), u1 = _mm256_unpackhi_pd(in[4], in[5]);
-    _mm256_store_pd(base + kRecord * index[0], _mm256_permute2f128_pd(t0, t2, 0x20));
-    _mm256_store_pd(base + kRecord * index[1], _mm256_permute2f128_pd(t1, t3, 0x20));
-    _mm256_store_pd(base + kRecord * index[2], _mm256_permute2f128_pd(t0, t2, 0x31));
-    _mm256_store_pd(base + kRecord * index[3], _mm256_permute2f128_pd(t1, t3, 0x31));
-    _mm_store_pd(base + kRecord * index[0] + 4, _mm256_castpd256_pd128(u0));
-    _mm_store_pd(base + kRecord * index[1] + 4, _mm256_castpd256_pd128(u1));
-    _mm_store_pd(base + kRecord * index[2] + 4, _mm256_extractf128_pd(u0, 1));
-    _mm_store_pd(base + kRecord * index[3] + 4, _mm256_extractf128_pd(u1, 1));
+    _mm256_store_pd(record_at(base, index[0]), _mm256_permute2f128_pd(t0, t2, 0x20));
+    _mm256_store_pd(record_at(base, index[1]), _mm256_permute2f128_pd(t1, t3, 0x20));
+    _mm256_store_pd(record_at(base, index[2]), _mm256_permute2f128_pd(t0, t2, 0x31));
+    _mm256_store_pd(record_at(base, index[3]), _mm256_permute2f128_pd(t1, t3, 0x31));
+    _mm_store_pd(record_at(base, index[0]) + 4, _mm256_castpd256_pd128(u0));
+    _mm_store_pd(record_at(base, index[1]) + 4, _mm256_castpd256_pd128(u1));
+    _mm_store_pd(record_at(base, index[2]) + 4, _mm256_extractf128_pd(u0, 1));
+    _mm_store_pd(record_at(base, index[3]) + 4, _mm256_extractf128_pd(u1, 1));
   }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE void store_directions(double* base, const int* index,
                                                               const V (&in)[3]) {
     const V zero = _mm256_setzero_pd();
     const V t0 = _mm256_unpacklo_pd(in[0], in[1]), t1 = _mm256_unpackhi_pd(in[0], in[1]);
     const V t2 = _mm256_unpacklo_pd(in[2], zero), t3 = _mm256_unpackhi_pd(in[2], zero);
-    _mm256_store_pd(base + kDirection * index[0], _mm256_permute2f128_pd(t0, t2, 0x20));
-    _mm256_store_pd(base + kDirection * index[1], _mm256_permute2f128_pd(t1, t3, 0x20));
-    _mm256_store_pd(base + kDirection * index[2], _mm256_permute2f128_pd(t0, t2, 0x31));
-    _mm256_store_pd(base + kDirection * index[3], _mm256_permute2f128_pd(t1, t3, 0x31));
+    _mm256_store_pd(record_at<kDirection>(base, index[0]), _mm256_permute2f128_pd(t0, t2, 0x20));
+    _mm256_store_pd(record_at<kDirection>(base, index[1]), _mm256_permute2f128_pd(t1, t3, 0x20));
+    _mm256_store_pd(record_at<kDirection>(base, index[2]), _mm256_permute2f128_pd(t0, t2, 0x31));
+    _mm256_store_pd(record_at<kDirection>(base, index[3]), _mm256_permute2f128_pd(t1, t3, 0x31));
   }
 };
 
@@ -232,10 +233,10 @@ struct Avx512Float {
   template <int Stride>
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V quarters(const float* base, const int* index, int l,
                                                      int offset) {
-    V r = _mm512_castps128_ps512(_mm_load_ps(base + Stride * index[l] + offset));
-    r = _mm512_insertf32x4(r, _mm_load_ps(base + Stride * index[l + 4] + offset), 1);
-    r = _mm512_insertf32x4(r, _mm_load_ps(base + Stride * index[l + 8] + offset), 2);
-    return _mm512_insertf32x4(r, _mm_load_ps(base + Stride * index[l + 12] + offset), 3);
+    V r = _mm512_castps128_ps512(_mm_load_ps(record_at<Stride>(base, index[l]) + offset));
+    r = _mm512_insertf32x4(r, _mm_load_ps(record_at<Stride>(base, index[l + 4]) + offset), 1);
+    r = _mm512_insertf32x4(r, _mm_load_ps(record_at<Stride>(base, index[l + 8]) + offset), 2);
+    return _mm512_insertf32x4(r, _mm_load_ps(record_at<Stride>(base, index[l + 12]) + offset), 3);
   }
   template <bool WithVelocity, int Stride = kRecord>
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void load_records(const float* base, const int* index,
@@ -274,10 +275,10 @@ struct Avx512Float {
       const V high = _mm512_shuffle_f32x4(r[l], q[l], 0xEE);  // r2 r3 q2 q3
       const V a = _mm512_shuffle_f32x4(low, low, 0xD8);       // r0 q0 r1 q1
       const V b = _mm512_shuffle_f32x4(high, high, 0xD8);     // r2 q2 r3 q3
-      _mm256_store_ps(base + kRecord * index[l], _mm512_castps512_ps256(a));
-      _mm256_store_ps(base + kRecord * index[l + 4], upper_half(a));
-      _mm256_store_ps(base + kRecord * index[l + 8], _mm512_castps512_ps256(b));
-      _mm256_store_ps(base + kRecord * index[l + 12], upper_half(b));
+      _mm256_store_ps(record_at(base, index[l]), _mm512_castps512_ps256(a));
+      _mm256_store_ps(record_at(base, index[l + 4]), upper_half(a));
+      _mm256_store_ps(record_at(base, index[l + 8]), _mm512_castps512_ps256(b));
+      _mm256_store_ps(record_at(base, index[l + 12]), upper_half(b));
     }
   }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void store_directions(float* base, const int* index,
@@ -288,10 +289,10 @@ struct Avx512Float {
     const V r[4] = {_mm512_shuffle_ps(t0, t2, 0x44), _mm512_shuffle_ps(t0, t2, 0xEE),
                     _mm512_shuffle_ps(t1, t3, 0x44), _mm512_shuffle_ps(t1, t3, 0xEE)};
     for (int l = 0; l < 4; ++l) {
-      _mm_store_ps(base + kDirection * index[l], _mm512_castps512_ps128(r[l]));
-      _mm_store_ps(base + kDirection * index[l + 4], _mm512_extractf32x4_ps(r[l], 1));
-      _mm_store_ps(base + kDirection * index[l + 8], _mm512_extractf32x4_ps(r[l], 2));
-      _mm_store_ps(base + kDirection * index[l + 12], _mm512_extractf32x4_ps(r[l], 3));
+      _mm_store_ps(record_at<kDirection>(base, index[l]), _mm512_castps512_ps128(r[l]));
+      _mm_store_ps(record_at<kDirection>(base, index[l + 4]), _mm512_extractf32x4_ps(r[l], 1));
+      _mm_store_ps(record_at<kDirection>(base, index[l + 8]), _mm512_extractf32x4_ps(r[l], 2));
+      _mm_store_ps(record_at<kDirection>(base, index[l + 12]), _mm512_extractf32x4_ps(r[l], 3));
     }
   }
 };
