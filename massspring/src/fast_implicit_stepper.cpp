@@ -170,8 +170,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::SoaLayout<Real> soa_;
   detail::NodeGatherLayout<Real, W> gather_;
   detail::Kernels<Real, W> kernels_;
-  detail::AlignedArray<Real> records_;    // x, v per node
-  detail::AlignedArray<Real> p_records_;  // CG direction per node (zero on constrained nodes)
+  detail::AlignedVector<Real> records_;    // x, v per node
+  detail::AlignedVector<Real> p_records_;  // CG direction per node (zero on constrained nodes)
   detail::ImplicitCoefficients<Real> system_;
   detail::AlignedVector<Real> dv_[3], residual_[3], direction_[3], product_[3];  // product_: z too
   detail::AlignedVector<Real> inverse_block_[6];

@@ -39,8 +39,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         team_(std::max(options.threads, 1)),
         soa_(model, options.reorder_nodes, team_.size()),
         gather_(soa_),
-        records_{detail::AlignedArray<Real>(kRecord * (soa_.num_nodes + 2)),
-                 detail::AlignedArray<Real>(kRecord * (soa_.num_nodes + 2))} {
+        records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
+                 detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))} {
     pack();
   }
 
@@ -147,7 +147,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   detail::ThreadTeam team_;
   detail::SoaLayout<Real> soa_;
   NodeGatherLayout<Real, W> gather_;
-  detail::AlignedArray<Real> records_[2];  // x, v per node (kRecord), previous and next step
+  detail::AlignedVector<Real> records_[2];  // x, v per node (kRecord), previous and next step
   std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;

@@ -47,26 +47,6 @@ inline T* record_at(T* base, int offset) {
 }
 constexpr int kBlockSlots = 4096;
 
-// Cache-line aligned array for the node records (the vector loads assume 32-byte alignment).
-template <class Real>
-class AlignedArray {
- public:
-  explicit AlignedArray(std::size_t size = 0)
-      : data_(new (std::align_val_t(64)) Real[size > 0 ? size : 1]()), size_(size) {}
-  ~AlignedArray() { ::operator delete[](data_, std::align_val_t(64)); }
-  AlignedArray(const AlignedArray&) = delete;
-  AlignedArray& operator=(const AlignedArray&) = delete;
-  Real* data() { return data_; }
-  const Real* data() const { return data_; }
-  std::size_t size() const { return size_; }
-  Real& operator[](std::size_t i) { return data_[i]; }
-  const Real& operator[](std::size_t i) const { return data_[i]; }
-
- private:
-  Real* data_;
-  std::size_t size_;
-};
-
 // Vectors whose data start on a cache line: the kernels' full-width vector loads and stores of
 // per-slot and per-lane arrays then never straddle two lines.
 template <class T>
