@@ -1,5 +1,6 @@
 // The files of a run: for scripts (summary.json), for people (report.md with plots), for ParaView
-// (surface_<variant>.vtu + surfaces.pvd, fem.pvd) and for analysis (fields.h5).
+// (surface_<variant>.vtu + surfaces.pvd, fem.pvd; fem.xdmf + fem.h5 for XDMF readers) and for
+// analysis (fields.h5).
 #include "msfem/compare/run_outputs.hpp"
 
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include "msfem/compare/atomic_file.hpp"
 #include "msfem/compare/plots.hpp"
 #include "msfem/compare/result_writers.hpp"
+#include "msfem/fem_reference/elasticity_problem.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -32,6 +34,9 @@ void write_surfaces(const CaseRun& run, const std::filesystem::path& dir) {
   write_volume_vtu(dir / "fem.vtu", run.mesh.vertices, run.mesh.tetrahedra,
                    {{"displacement", run.fem.vertex_displacement}});
   write_pvd(dir / "fem.pvd", {{"fem.vtu", "fem"}});
+  // The same volume field through deal.II's HDF5 + XDMF writer (also when the FEM came from the
+  // cache: the vertex displacements are all it needs).
+  fem_reference::write_vertex_displacement_hdf5(run.mesh, run.fem.vertex_displacement, dir, "fem");
 }
 
 void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
@@ -135,6 +140,7 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
   md << "## Files\n\n- `summary.json`: every number above\n"
         "- `surfaces.pvd`: the surface of each variant with displacement, error vector and "
         "magnitude (ParaView)\n- `fem.pvd`: the FEM solution\n"
+        "- `fem.xdmf` + `fem.h5`: the FEM solution for XDMF readers (ParaView, VisIt, h5py)\n"
         "- `fields.h5`: FEM volume field, per-variant surface displacement and error\n";
   return md.str();
 }
