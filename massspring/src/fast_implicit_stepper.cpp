@@ -35,7 +35,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       : model_(&model),
         options_(options),
         team_(std::max(options.threads, 1)),
-        soa_(model, options.reorder_nodes, team_.size()),
+        soa_(model, options.reorder_nodes),
         gather_(soa_),
         records_(kRecord * (soa_.num_nodes + 2)),
         p_records_(detail::kDirection * (soa_.num_nodes + 2)) {

@@ -37,7 +37,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   GatherExplicitStepper(const MassSpringModel& model, const FastStepperOptions& options)
       : model_(&model),
         team_(std::max(options.threads, 1)),
-        soa_(model, options.reorder_nodes, team_.size()),
+        soa_(model, options.reorder_nodes),
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))} {

@@ -2,8 +2,8 @@
 
 // Structure-of-arrays copy of a MassSpringModel shared by the fast steppers (internal): nodes
 // renumbered (reverse Cuthill-McKee, constrained nodes last), springs sorted by their first node,
-// CSR incidence of springs on free nodes with the sign of the spring force on that node, and the
-// per-node constant terms (loads, anchors, damping).
+// CSR incidence of springs on free nodes, and the per-node constant terms (loads, anchors,
+// damping). The steppers' node-centric layout (node_gather_layout.hpp) is built from it.
 
 #include <algorithm>
 #include <numeric>
@@ -23,12 +23,11 @@ struct SoaLayout {
   bool has_spring_damping = false;
   std::vector<int> order, new_id, spring_old_id;  // order[new] = old
   std::vector<int> a, b, offset, incident;
-  std::vector<Real> stiffness, stiffness_rest, rest_length, damping, sign;
+  std::vector<Real> stiffness, stiffness_rest, rest_length, damping;
   std::vector<Real> inverse_mass, mass, node_damping, anchor_stiffness;
   std::vector<Real> x[3], v[3], load[3];
-  std::vector<int> spring_begin, node_begin;  // per thread-team member
 
-  SoaLayout(const MassSpringModel& model, bool reorder, int members) {
+  SoaLayout(const MassSpringModel& model, bool reorder) {
     const SpringNetwork& net = model.network();
     num_nodes = net.num_nodes();
     num_springs = net.num_springs();
@@ -46,7 +45,6 @@ struct SoaLayout {
     anchor_stiffness.assign(num_nodes, Real(0));
     load_parameters(model);
     set_state(model, initial_state(model));
-    partition(members);
   }
 
   void load_parameters(const MassSpringModel& model) {
@@ -162,36 +160,11 @@ struct SoaLayout {
     }
     std::partial_sum(offset.begin(), offset.end(), offset.begin());
     incident.resize(offset.back());
-    sign.resize(offset.back());
     std::vector<int> fill(offset.begin(), offset.end() - 1);
     for (int s = 0; s < num_springs; ++s) {
-      if (a[s] < num_free) {
-        incident[fill[a[s]]] = s;
-        sign[fill[a[s]]++] = Real(1);
-      }
-      if (b[s] < num_free) {
-        incident[fill[b[s]]] = s;
-        sign[fill[b[s]]++] = Real(-1);
-      }
+      if (a[s] < num_free) incident[fill[a[s]]++] = s;
+      if (b[s] < num_free) incident[fill[b[s]]++] = s;
     }
-  }
-
-  // Equal shares of springs; node shares balanced by incidence count (the gather's work).
-  void partition(int members) {
-    spring_begin.resize(members + 1);
-    node_begin.resize(members + 1);
-    for (int m = 0; m <= members; ++m)
-      spring_begin[m] = static_cast<int>(static_cast<long>(num_springs) * m / members);
-    node_begin[0] = 0;
-    int node = 0;
-    const long total = static_cast<long>(offset.back()) + num_free;
-    for (int m = 1; m < members; ++m) {
-      const long target = total * m / members;
-      while (node < num_free && offset[node] + node < target)
-        ++node;
-      node_begin[m] = node;
-    }
-    node_begin[members] = num_free;
   }
 };
 
