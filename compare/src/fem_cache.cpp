@@ -91,6 +91,7 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     s.vertex_displacement = matrix_from(j.at("vertex_displacement"));
     s.surface_displacement = s.vertex_displacement.topRows(j.at("case_surface_vertices"));
     s.tool_force = vec_from(j.at("tool_force"));
+    s.solver = j.at("solver");
     s.volume_change = j.at("volume_change");
     const auto& st = j.at("statistics");
     s.statistics.dofs = st.at("dofs");
@@ -126,6 +127,7 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                             {"vertex_displacement", matrix_json(s.vertex_displacement)},
                             {"case_surface_vertices", s.surface_displacement.rows()},
                             {"tool_force", vec(s.tool_force)},
+                            {"solver", s.solver},
                             {"volume_change", s.volume_change},
                             {"statistics",
                              {{"dofs", st.dofs},

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
+#include <memory>
 
 #include "msfem/cases/surface.hpp"
 #include "msfem/cases/surface_refinement.hpp"
+#include "msfem/fem_reference/errors.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
 #include "msfem/fem_reference/surface_mesher.hpp"
 
@@ -103,14 +106,27 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
     }
   }
 
-  fem_reference::ElasticityProblem fem(mesh, model);
-  fem.run();
   FemSolution solution;
-  solution.vertex_displacement = fem.vertex_displacements();
+  solution.solver = p.fem.solver;
+  auto fem = std::make_unique<fem_reference::ElasticityProblem>(mesh, model);
+  try {
+    fem->run();
+  } catch (const fem_reference::SolverError& e) {
+    // GAMG's smoothers can turn indefinite on a graded mesh (the tool refinement's); BoomerAMG
+    // copes with those, so one failure does not end a long run or a calibration.
+    if (model.solver.preconditioner != fem_reference::Preconditioner::gamg) throw;
+    std::cerr << "msfem: " << e.what() << "; solving again with CG + BoomerAMG\n";
+    model.solver.preconditioner = fem_reference::Preconditioner::boomer_amg;
+    fem = std::make_unique<fem_reference::ElasticityProblem>(mesh, model);
+    fem->run();
+    solution.solver = "cg_boomeramg (cg_gamg failed: " + std::string(e.what()) + ")";
+  }
+  const fem_reference::ElasticityProblem& fem_solved = *fem;
+  solution.vertex_displacement = fem_solved.vertex_displacements();
   solution.surface_displacement =
       solution.vertex_displacement.topRows(problem.surface.num_vertices());
-  if (tool) solution.tool_force = -fem.reaction_force("tool");
-  solution.statistics = fem.statistics();
+  if (tool) solution.tool_force = -fem_solved.reaction_force("tool");
+  solution.statistics = fem_solved.statistics();
   solution.volume_change = volume_change(problem.surface, solution.surface_displacement);
   return solution;
 }

@@ -71,7 +71,7 @@ nlohmann::json summary_json(const CaseRun& run) {
                         {"solve_time_s", st.solve_time_s},
                         {"assemble_time_s", st.assemble_time_s},
                         {"iterations", st.iterations},
-                        {"solver", p.fem.solver},
+                        {"solver", run.fem.solver.empty() ? p.fem.solver : run.fem.solver},
                         {"mpi_ranks", st.mpi_ranks},
                         {"reaction_force_N", vec(run.fem.tool_force)},
                         {"volume_change", run.fem.volume_change},

@@ -1,6 +1,7 @@
 #include "petsc_linear_system.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -9,6 +10,13 @@
 namespace msfem::fem_reference::detail {
 
 namespace {
+
+// std::to_string prints 1e-10 as 0.000000.
+std::string scientific(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
 
 void check(PetscErrorCode code, const char* call) {
   if (code != 0)
@@ -223,8 +231,8 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
   if (solve_code != 0 || reason < 0)
     throw SolverError(std::string(method_name(settings.preconditioner)) + " did not converge: " +
                       reason_text(reason) + " after " + std::to_string(iterations) +
-                      " iterations, residual norm " + std::to_string(residual) +
-                      " (relative tolerance " + std::to_string(settings.relative_tolerance) + ")");
+                      " iterations, residual norm " + scientific(double(residual)) +
+                      " (relative tolerance " + scientific(settings.relative_tolerance) + ")");
   return {int(iterations), double(residual)};
 }
 

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "msfem/compare/problem.hpp"
@@ -22,6 +23,7 @@ struct FemSolution {
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();  ///< force the tissue exerts on the tool, N
   double volume_change = 0.0;  ///< deformed / rest enclosed volume − 1 of the surface
   fem_reference::SolveStatistics statistics;
+  std::string solver;  ///< the solver that produced it (the case's, or the fallback and why)
 };
 
 /// Solves the problem's FEM for `tool` (none: gravity and patch force only).
