@@ -1,7 +1,10 @@
 #include "msfem/compare/atomic_file.hpp"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -19,6 +22,69 @@ fs::path temporary_name_for(const fs::path& path) {
   return path.parent_path() / (path.filename().string() + ".tmp." + std::to_string(::getpid()));
 }
 
+// Temporaries in progress, removed if SIGINT, SIGTERM or SIGHUP ends the program, so an
+// interrupted run leaves nothing behind. The handler may only make async-signal-safe calls: fork,
+// execv and waitpid are, a recursive directory removal is not, hence rm in a child process.
+constexpr int kMaxPending = 8;
+char pending_paths[kMaxPending][4096];
+volatile std::sig_atomic_t pending_used[kMaxPending] = {};
+
+extern "C" void remove_pending_and_reraise(int signal_number) {
+  for (int i = 0; i < kMaxPending; ++i) {
+    if (!pending_used[i]) continue;
+    const pid_t child = ::fork();
+    if (child == 0) {
+      char rm[] = "rm", flags[] = "-rf", end[] = "--";
+      char* argv[] = {rm, flags, end, pending_paths[i], nullptr};
+      ::execv("/bin/rm", argv);
+      ::_exit(127);
+    }
+    if (child > 0) ::waitpid(child, nullptr, 0);
+  }
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
+void install_cleanup_handlers() {
+  static bool installed = false;
+  if (installed) return;
+  installed = true;
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction current {};
+    if (::sigaction(signal_number, nullptr, &current) != 0) continue;
+    if (current.sa_handler != SIG_DFL) continue;  // the embedding program's own handler wins
+    struct sigaction action {};
+    action.sa_handler = remove_pending_and_reraise;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
+
+// Registers a temporary for removal on a signal while it is alive.
+class PendingTemporary {
+ public:
+  explicit PendingTemporary(const fs::path& path) {
+    const std::string text = fs::absolute(path).string();
+    if (text.size() >= sizeof pending_paths[0]) return;
+    install_cleanup_handlers();
+    for (int i = 0; i < kMaxPending; ++i)
+      if (!pending_used[i]) {
+        std::memcpy(pending_paths[i], text.c_str(), text.size() + 1);
+        pending_used[i] = 1;
+        slot_ = i;
+        return;
+      }
+  }
+  ~PendingTemporary() {
+    if (slot_ >= 0) pending_used[slot_] = 0;
+  }
+  PendingTemporary(const PendingTemporary&) = delete;
+  PendingTemporary& operator=(const PendingTemporary&) = delete;
+
+ private:
+  int slot_ = -1;
+};
+
 void remove_quietly(const fs::path& path) {
   std::error_code ignored;
   fs::remove(path, ignored);
@@ -31,6 +97,7 @@ void write_file_atomically(const fs::path& path,
   if (path.filename().empty())
     throw std::runtime_error("cannot write '" + path.string() + "': not a file name");
   const fs::path temporary = temporary_name_for(path);
+  const PendingTemporary pending(temporary);
   try {
     write(temporary);
     if (!fs::is_regular_file(temporary)) throw std::runtime_error("the writer produced no file");
@@ -59,6 +126,7 @@ void fill_directory_atomically(const fs::path& directory,
   if (fs::exists(directory) && !(fs::is_directory(directory) && fs::is_empty(directory)))
     throw cases::InputError(directory.string() + ": output folder exists and is not empty");
   const fs::path work = temporary_name_for(directory);
+  const PendingTemporary pending(work);
   fs::create_directories(work);
   try {
     fill(work);

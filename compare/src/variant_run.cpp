@@ -45,10 +45,10 @@ ms::SpringNetwork build_network(const std::string& name, const Problem& problem,
   }
   if (name == "single_layer") {
     ms::SingleLayerOptions o;
-    // Tied to rest only where no surface node is supported (as simulators do).
+    // Every node not supported is tied to its rest position (as simulators' rest-shape springs
+    // do; the supported ones are fixed, so their anchors do nothing). A bare membrane held only at
+    // some nodes, like the brain's base, has no transverse stiffness at rest: Newton failed on it.
     o.anchor_to_rest = true;
-    for (Eigen::Index v = 0; v < s.num_vertices() && o.anchor_to_rest; ++v)
-      o.anchor_to_rest = !problem.fixed_region(s.vertices.row(v).transpose());
     o.material = material;
     return ms::build_single_layer(s.vertices, s.triangles, o);
   }

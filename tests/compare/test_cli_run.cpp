@@ -160,6 +160,22 @@ TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
   EXPECT_NE(bad_set.err.find("four_tier"), std::string::npos) << bad_set.err;
 }
 
+TEST(CliRun, AnInterruptedRunLeavesNeitherItsFolderNorItsTemporary) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "run";
+  // Start a run, wait until its temporary folder exists, then send SIGTERM as a batch system would.
+  const std::string script =
+      std::string(MSFEM_EXECUTABLE) + " run " + small_case + " --quiet --no-cache --out " +
+      out.string() + " >/dev/null 2>&1 & pid=$!; for i in $(seq 1 300); do " + "ls -d " +
+      out.string() + ".tmp.* >/dev/null 2>&1 && break; sleep 0.02; done; kill -TERM $pid; " +
+      "wait $pid; echo $? >" + (tmp / "status").string();
+  ASSERT_EQ(std::system(("bash -c '" + script + "'").c_str()), 0);
+  EXPECT_EQ(read_text(tmp / "status"), "143\n");  // 128 + SIGTERM: the signal still ends it
+  EXPECT_FALSE(std::filesystem::exists(out));
+  for (const auto& entry : std::filesystem::directory_iterator(tmp.path()))
+    EXPECT_EQ(entry.path().filename().string().find("run.tmp."), std::string::npos) << entry.path();
+}
+
 TEST(CliParams, PrintsTheWholeLanguage) {
   const auto r = run_msfem("params");
   ASSERT_EQ(r.exit_code, 0);
