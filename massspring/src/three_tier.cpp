@@ -64,14 +64,18 @@ double stiffness_volume(SpringNetwork& network, const Eigen::MatrixX3d& outer,
 
 void check_nesting(SpringNetwork& network, const Eigen::MatrixX3d& inner,
                    const Eigen::MatrixX3d& outer, const Eigen::MatrixX3i& triangles,
-                   const char* inner_name, const char* outer_name, bool reject) {
+                   const char* inner_name, const char* outer_name, InnerTierMethod method,
+                   bool reject) {
   const std::vector<int> outside = points_outside_surface(inner, outer, triangles);
   if (outside.empty()) return;
   const std::string message =
       std::string("three_tier: ") + std::to_string(outside.size()) + " of " +
       std::to_string(inner.rows()) + " " + inner_name + " nodes (first: vertex " +
       std::to_string(outside.front()) + ") lie outside " + outer_name +
-      "; scaling a concave surface does that, use InnerTierMethod::normal_offset";
+      (method == InnerTierMethod::scaling
+           ? "; scaling a concave surface does that, use InnerTierMethod::normal_offset"
+           : "; an inward offset deeper than the surface's folds are wide folds the tier over "
+             "itself, use smaller tier offsets or a smoothed surface");
   if (reject) throw ModelError(message);
   network.warnings.push_back(message);
 }
@@ -94,9 +98,9 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
                                             options.tier3_scale, options.tier3_offset);
 
   SpringNetwork network;
-  check_nesting(network, tier2, vertices, triangles, "tier 2", "tier 1",
+  check_nesting(network, tier2, vertices, triangles, "tier 2", "tier 1", options.inner_tiers,
                 options.reject_inner_tier_outside);
-  check_nesting(network, tier3, tier2, triangles, "tier 3", "tier 2",
+  check_nesting(network, tier3, tier2, triangles, "tier 3", "tier 2", options.inner_tiers,
                 options.reject_inner_tier_outside);
 
   detail::add_nodes(network, vertices, "tier1");
