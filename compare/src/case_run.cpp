@@ -132,56 +132,67 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   for (int i = 0; i < total; ++i) {
     const std::string& name = parameters.mass_spring.variants[i];
     BuiltVariant built = build_variant(name, problem, run.mesh, tool);
-    VariantResult r;
-    r.name = name;
-    r.nodes = built.model->num_nodes();
-    r.springs = built.model->network().num_springs();
-    r.warnings = built.warnings;
-    r.parameters = variant_parameters(*built.model);
-    StaticSolution s;
-    if (depths.empty()) {
-      s = solve_variant_static(built);
-    } else {
-      // A quasi-static loading path, each depth started from the last, as a tool pressed in steps
-      // is: a network with several equilibria (one that buckles under the tool) then stays on the
-      // branch a simulator would follow, and the curve is the force a haptic device would render.
-      std::vector<double> path = depths;
-      path.push_back(tool->depth);
-      std::sort(path.begin(), path.end());
-      path.erase(std::unique(path.begin(), path.end()), path.end());
-      Eigen::VectorXd x;
-      for (double depth : path) {
-        set_tool_depth(built, problem, at_depth(*tool, depth));
-        StaticSolution at = solve_variant_static(built, x);
-        x = at.x;
-        if (std::find(depths.begin(), depths.end(), depth) != depths.end())
-          r.force_depth.push_back({depth, at.tool_force});
-        if (depth == tool->depth) s = std::move(at);
+    try {
+      VariantResult r;
+      r.name = name;
+      r.nodes = built.model->num_nodes();
+      r.springs = built.model->network().num_springs();
+      r.warnings = built.warnings;
+      r.parameters = variant_parameters(*built.model);
+      StaticSolution s;
+      if (depths.empty()) {
+        s = solve_variant_static(built);
+      } else {
+        // A quasi-static loading path, each depth started from the last, as a tool pressed in steps
+        // is: a network with several equilibria (one that buckles under the tool) then stays on the
+        // branch a simulator would follow, and the curve is the force a haptic device would render.
+        std::vector<double> path = depths;
+        path.push_back(tool->depth);
+        std::sort(path.begin(), path.end());
+        path.erase(std::unique(path.begin(), path.end()), path.end());
+        Eigen::VectorXd x;
+        for (double depth : path) {
+          set_tool_depth(built, problem, at_depth(*tool, depth));
+          StaticSolution at = solve_variant_static(built, x);
+          x = at.x;
+          if (std::find(depths.begin(), depths.end(), depth) != depths.end())
+            r.force_depth.push_back({depth, at.tool_force});
+          if (depth == tool->depth) s = std::move(at);
+        }
+        set_tool_depth(built, problem, *tool);
       }
-      set_tool_depth(built, problem, *tool);
+      r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
+      if (r.force_depth_monotone == false)
+        r.warnings.push_back(
+            "the reaction force does not grow with depth along the loading path: the network "
+            "buckles or snaps under the tool (a spring network has no resistance to inverted "
+            "elements), so its force-depth curve is not one a haptic device should render");
+      r.newton_iterations = s.newton_iterations;
+      r.surface_displacement = s.surface_displacement;
+      r.error = s.surface_displacement - run.fem.surface_displacement;
+      const Eigen::Vector3d zone_center = tool ? tool->contact_point : problem.centroid;
+      const double zone_radius = tool ? 2 * tool->radius : 0.0;
+      r.errors = zoned_displacement_error(s.surface_displacement, run.fem.surface_displacement,
+                                          problem.surface.vertices, run.compared_vertices,
+                                          zone_center, zone_radius);
+      r.tool_force = s.tool_force;
+      if (tool)
+        r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
+      r.volume_change = volume_change(problem.surface, s.surface_displacement);
+      if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
+      run.variants.push_back(std::move(r));
+    } catch (const cases::InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      // One variant's Newton or time stepping failing must not cost the others' results.
+      run.failed_variants.emplace_back(name, e.what());
+      progress.stage("variant " + name + " failed: " + e.what());
     }
-    r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
-    if (r.force_depth_monotone == false)
-      r.warnings.push_back(
-          "the reaction force does not grow with depth along the loading path: the network "
-          "buckles or snaps under the tool (a spring network has no resistance to inverted "
-          "elements), so its force-depth curve is not one a haptic device should render");
-    r.newton_iterations = s.newton_iterations;
-    r.surface_displacement = s.surface_displacement;
-    r.error = s.surface_displacement - run.fem.surface_displacement;
-    const Eigen::Vector3d zone_center = tool ? tool->contact_point : problem.centroid;
-    const double zone_radius = tool ? 2 * tool->radius : 0.0;
-    r.errors = zoned_displacement_error(s.surface_displacement, run.fem.surface_displacement,
-                                        problem.surface.vertices, run.compared_vertices,
-                                        zone_center, zone_radius);
-    r.tool_force = s.tool_force;
-    if (tool)
-      r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
-    r.volume_change = volume_change(problem.surface, s.surface_displacement);
-    if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
-    run.variants.push_back(std::move(r));
     progress.advance("variant " + name, i + 1, total, seconds_since(variants_start));
   }
+  if (run.variants.empty() && !run.failed_variants.empty())
+    throw std::runtime_error("every variant failed; the first, " + run.failed_variants[0].first +
+                             ": " + run.failed_variants[0].second);
   run.wall_time_s = seconds_since(start);
   return run;
 }

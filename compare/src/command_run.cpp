@@ -26,6 +26,7 @@ int run_command(const Arguments& args) {
                                               : std::filesystem::path(parameters.output.directory) /
                                                     (parameters.name + "-" + run_timestamp());
   std::ostringstream printed;  // shown once the folder is in place
+  std::vector<std::pair<std::string, std::string>> failed;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
     RunSettings settings;
     settings.quiet = opt.flag("quiet");
@@ -35,6 +36,7 @@ int run_command(const Arguments& args) {
       settings.fem_cache_directory =
           std::filesystem::path(parameters.output.directory) / ".fem-cache";
     const CaseRun run = run_case(parameters, settings);
+    failed = run.failed_variants;
     write_run_outputs(run, work_dir);
     if (opt.flag("json")) {
       printed << summary_json(run).dump(2) << '\n';
@@ -46,7 +48,9 @@ int run_command(const Arguments& args) {
     }
   });
   std::cout << printed.str();
-  return 0;
+  for (const auto& [name, why] : failed)
+    std::cerr << "msfem run: variant " << name << " failed: " << why << "\n";
+  return failed.empty() ? 0 : 1;  // the others' results are written; scripts still see it
 }
 
 int params_command(const Arguments& args) {

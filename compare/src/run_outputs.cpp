@@ -134,6 +134,8 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
   for (const auto& v : run.variants)
     for (const auto& w : v.warnings)
       md << "\n> " << v.name << ": " << w << "\n";
+  for (const auto& [name, why] : run.failed_variants)
+    md << "\n> **" << name << " failed** and is left out of the tables and plots: " << why << "\n";
   md << "\n## Plots\n\n";
   for (const auto& l : plots)
     md << l << "\n\n";

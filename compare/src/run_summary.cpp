@@ -117,6 +117,9 @@ nlohmann::json summary_json(const CaseRun& run) {
                         {"warnings", v.warnings},
                         {"parameters", v.parameters}});
   }
+  nlohmann::json failed = nlohmann::json::array();
+  for (const auto& [name, why] : run.failed_variants)
+    failed.push_back({{"name", name}, {"error", why}});
   nlohmann::json tools = nlohmann::json::array();
   for (const auto& t : run.problem.tools)
     tools.push_back({{"vertex", t.vertex},
@@ -142,6 +145,7 @@ nlohmann::json summary_json(const CaseRun& run) {
           {"notes", run.problem.notes},
           {"fem", fem},
           {"variants", variants},
+          {"failed_variants", failed},
           {"wall_time_s", run.wall_time_s}};
 }
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "msfem/compare/fem_run.hpp"
@@ -58,6 +59,9 @@ struct CaseRun {
   std::vector<ForceDepthPoint> fem_force_depth;
   std::optional<bool> fem_force_depth_monotone;
   std::vector<VariantResult> variants;
+  /// Variants whose statics or dynamics failed (a solver, not the input): name and message. The
+  /// others are still compared; bad input stops the whole run.
+  std::vector<std::pair<std::string, std::string>> failed_variants;
   std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
   double wall_time_s = 0.0;
   std::string fem_cache_key;
