@@ -124,11 +124,13 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
         "| "
         "settle time s |\n|---|---|---|---|---|---|\n";
   for (const auto& v : run.variants) {
-    char row[256];
-    std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %.3f%s |\n", v.name.c_str(),
+    char row[256], settle[64] = "-";
+    if (!v.timing.integrator.empty())
+      std::snprintf(settle, sizeof settle, "%.3f%s", v.timing.settle_time_s,
+                    v.timing.settled ? "" : " (not settled)");
+    std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %s |\n", v.name.c_str(),
                   v.errors.contact_zone.rel_l2_error, v.errors.far_field.rel_l2_error,
-                  v.errors.all.mean_error_over_max_disp, v.volume_change, v.timing.settle_time_s,
-                  v.timing.settled ? "" : " (not settled)");
+                  v.errors.all.mean_error_over_max_disp, v.volume_change, settle);
     md << row;
   }
   for (const auto& v : run.variants)

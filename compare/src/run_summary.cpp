@@ -166,12 +166,19 @@ std::string variant_table(const CaseRun& run) {
                 run.fem.tool_force.norm(), "-", "-", "-", "-");
   out << line;
   for (const auto& v : run.variants) {
-    std::snprintf(
-        line, sizeof line,
-        "| %-12s | %6d | %7d | %9.4f | %9.4f | %9.4g | %9.4f | %10.0f | %9.3g | %9.3f |\n",
-        v.name.c_str(), v.nodes, v.springs, v.errors.all.rel_l2_error,
-        1e3 * v.errors.all.max_error_m, v.tool_force.norm(), v.reaction_force_rel_error,
-        v.timing.steps_per_second, v.timing.stable_dt_s, v.timing.ms_per_60hz_frame);
+    // Not timed (--no-timing): dashes, not zeros that read as measurements.
+    const bool timed = !v.timing.integrator.empty();
+    char steps[32] = "-", dt[32] = "-", frame[32] = "-";
+    if (timed) {
+      std::snprintf(steps, sizeof steps, "%.0f", v.timing.steps_per_second);
+      std::snprintf(dt, sizeof dt, "%.3g", v.timing.stable_dt_s);
+      std::snprintf(frame, sizeof frame, "%.3f", v.timing.ms_per_60hz_frame);
+    }
+    std::snprintf(line, sizeof line,
+                  "| %-12s | %6d | %7d | %9.4f | %9.4f | %9.4g | %9.4f | %10s | %9s | %9s |\n",
+                  v.name.c_str(), v.nodes, v.springs, v.errors.all.rel_l2_error,
+                  1e3 * v.errors.all.max_error_m, v.tool_force.norm(), v.reaction_force_rel_error,
+                  steps, dt, frame);
     out << line;
   }
   return out.str();
