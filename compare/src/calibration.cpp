@@ -81,8 +81,7 @@ LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d
   return e;
 }
 
-LoadModels models_for(const BuiltVariant& base, const Problem& problem,
-                      const std::vector<LoadReference>& references) {
+LoadModels models_for(const BuiltVariant& base, const std::vector<LoadReference>& references) {
   LoadModels m;
   for (const auto& r : references) {
     BuiltVariant v;
@@ -90,7 +89,7 @@ LoadModels models_for(const BuiltVariant& base, const Problem& problem,
     v.model = std::make_unique<ms::MassSpringModel>(*base.model);
     v.tool_patch = base.tool_patch;
     v.case_surface_vertices = base.case_surface_vertices;
-    set_tool_depth(v, problem, r.tool);
+    set_tool_depth(v, r.tool);
     m.variants.push_back(std::move(v));
     m.x.emplace_back();
   }
@@ -136,17 +135,16 @@ struct FreeDofs {
 
 }  // namespace
 
-LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
-                         const LoadReference& reference, Eigen::VectorXd& x) {
-  set_tool_depth(variant, problem, reference.tool);
+LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference,
+                         Eigen::VectorXd& x) {
+  set_tool_depth(variant, reference.tool);
   const StaticSolution s = solve_variant_static(variant, x);
   x = s.x;
   return errors_against(reference, s.surface_displacement, s.tool_force);
 }
 
-LoadErrors evaluate_load_linear(BuiltVariant& variant, const Problem& problem,
-                                const LoadReference& reference) {
-  set_tool_depth(variant, problem, reference.tool);
+LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference) {
+  set_tool_depth(variant, reference.tool);
   LinearisedStatics statics(*variant.model, {variant.model->network().stiffness});
   const auto s = statics.solve({1.0}, variant.tool_patch);
   return errors_against(reference, s.surface_displacement, s.patch_force);
@@ -198,8 +196,8 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
     return k;
   };
 
-  LoadModels train_models = models_for(base, problem, train);
-  LoadModels test_models = models_for(base, problem, test);
+  LoadModels train_models = models_for(base, train);
+  LoadModels test_models = models_for(base, test);
   if (options.linear) {
     // Part 0: the springs not fitted (weight 1); part g + 1: fitted group g (weight exp θ_g).
     std::vector<Eigen::VectorXd> parts(n + 1, Eigen::VectorXd::Zero(network.num_springs()));

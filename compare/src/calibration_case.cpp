@@ -222,7 +222,7 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
       group_scales_assignment(calibrated.parameters.mass_spring.group_scales));
   BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
   Eigen::VectorXd x;
-  const LoadErrors check = evaluate_load(built, calibrated, c.train.front(), x);
+  const LoadErrors check = evaluate_load(built, c.train.front(), x);
   c.nonlinear_check = check;
   if (c.options.linear)
     c.notes.push_back(
@@ -264,8 +264,8 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
         for (const auto& r : c.test) {
           Eigen::VectorXd xo;
           // The same model as the fit's, so that the comparison is like for like.
-          errors.push_back(c.options.linear ? evaluate_load_linear(other, c.problem, r)
-                                            : evaluate_load(other, c.problem, r, xo));
+          errors.push_back(c.options.linear ? evaluate_load_linear(other, r)
+                                            : evaluate_load(other, r, xo));
         }
       } catch (const std::runtime_error& e) {
         // A comparison only: say so and go on, the calibration itself stands.

@@ -152,14 +152,14 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
         path.erase(std::unique(path.begin(), path.end()), path.end());
         Eigen::VectorXd x;
         for (double depth : path) {
-          set_tool_depth(built, problem, at_depth(*tool, depth));
+          set_tool_depth(built, at_depth(*tool, depth));
           StaticSolution at = solve_variant_static(built, x);
           x = at.x;
           if (std::find(depths.begin(), depths.end(), depth) != depths.end())
             r.force_depth.push_back({depth, at.tool_force});
           if (depth == tool->depth) s = std::move(at);
         }
-        set_tool_depth(built, problem, *tool);
+        set_tool_depth(built, *tool);
       }
       r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
       if (r.force_depth_monotone == false)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "msfem/cases/surface.hpp"
 #include "msfem/cases/surface_refinement.hpp"
@@ -32,7 +33,7 @@ fem_reference::VolumeMesh mesh_problem(const Problem& problem,
   options.cell_size = p.fem.cell_size_m > 0 ? p.fem.cell_size_m : edge;
   if (!refine_near && !problem.tools.empty()) refine_near = {problem.tools.front()};
   const std::vector<ToolPlacement> tools = refine_near.value_or(std::vector<ToolPlacement>{});
-  cases::Surface surface = problem.surface;
+  std::optional<cases::Surface> refined;  // the case's own surface unless refined
   double tool_cell = 0.5 * options.cell_size;
   if (p.fem.refine_at_tool && !tools.empty()) {
     // The refined surface keeps the case's vertices first, so mesh vertex i is still surface
@@ -44,11 +45,12 @@ fem_reference::VolumeMesh mesh_problem(const Problem& problem,
       radius = std::max(radius, t.radius);
     }
     tool_cell = p.fem.tool_cell_size_m > 0 ? p.fem.tool_cell_size_m : radius / 3;
-    surface = cases::refine_near(problem.surface, balls, tool_cell).surface;
+    refined = cases::refine_near(problem.surface, balls, tool_cell).surface;
   }
   for (const ToolPlacement& t : tools)
     options.refinements.push_back(
         fem_reference::LocalRefinement{t.contact_point, 2 * t.radius, 2 * t.radius, tool_cell});
+  const cases::Surface& surface = refined ? *refined : problem.surface;
   return fem_reference::mesh_closed_surface(surface.vertices, surface.triangles, options);
 }
 

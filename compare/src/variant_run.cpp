@@ -112,7 +112,7 @@ const std::vector<std::string>& known_variants() {
   return names;
 }
 
-void set_tool_depth(BuiltVariant& variant, const Problem& /*problem*/, const ToolPlacement& tool) {
+void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool) {
   const fem_reference::Support support = tool_patch_support(tool);
   ms::MassSpringModel& model = *variant.model;
   for (int node : variant.tool_patch)
@@ -160,7 +160,7 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
     set_damping_ratio(model, p.mass_spring.damping_ratio);
     model.set_gravity(p.loads.gravity_m_per_s2);
     apply_patch_force(model, problem);
-    if (tool) set_tool_depth(variant, problem, *tool);
+    if (tool) set_tool_depth(variant, *tool);
   } catch (const ms::ModelError& e) {
     throw cases::InputError(p.file.string() + ": variant " + name + ": " + e.what());
   }

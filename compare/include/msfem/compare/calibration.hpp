@@ -87,13 +87,11 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
 
 /// Errors of a built variant on one reference (its tool set to the reference's), with the static
 /// solve warm-started from `x` when it has the right size; `x` is updated to the equilibrium.
-LoadErrors evaluate_load(BuiltVariant& variant, const Problem& problem,
-                         const LoadReference& reference, Eigen::VectorXd& x);
+LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x);
 
 /// The same on the model linearised at rest (one Cholesky factorisation); throws
 /// std::runtime_error where that stiffness is singular.
-LoadErrors evaluate_load_linear(BuiltVariant& variant, const Problem& problem,
-                                const LoadReference& reference);
+LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference);
 
 /// The damping ratio of the case's per-spring damping ("mass spring/damping ratio") that gives a
 /// mode of the loaded model the modal damping ratio `target` (springs damp along their axis with d

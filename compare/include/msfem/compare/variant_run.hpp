@@ -35,7 +35,7 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
                            const std::optional<ToolPlacement>& tool);
 
 /// Moves the tool of an already built variant to another depth (the force-depth curve).
-void set_tool_depth(BuiltVariant& variant, const Problem& problem, const ToolPlacement& tool);
+void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool);
 
 struct StaticSolution {
   Eigen::VectorXd x;                                     ///< node-major positions at equilibrium
