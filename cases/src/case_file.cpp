@@ -87,6 +87,11 @@ void declare_loads(ParameterHandler& prm) {
   prm.declare_entry("curve depths", "", Patterns::List(Patterns::Double(0)),
                     "Depths (m) of the force-depth curve; empty: a quarter, half, three quarters "
                     "and all of the depth.");
+  prm.declare_entry("path step", "0", Patterns::Double(0),
+                    "Largest depth increment (m) of the spring variants' quasi-static loading "
+                    "path through the curve depths: steps in between are solved, each from the "
+                    "last, and are points of the variant's force-depth curve. 0: the curve "
+                    "depths only.");
   prm.leave_subsection();
   prm.enter_subsection("patch force");
   prm.declare_entry("enabled", "false", Patterns::Bool(), "Pull a surface patch.");
@@ -303,6 +308,7 @@ CaseParameters extract(ParameterHandler& prm) {
   tool.depth_m = prm.get_double("depth");
   for (const auto& d : dealii::Utilities::split_string_list(prm.get("curve depths")))
     tool.curve_depths_m.push_back(std::stod(d));
+  tool.path_step_m = prm.get_double("path step");
   prm.leave_subsection();
   if (tool.enabled && !(tool.radius_m > 0 && tool.depth_m > 0))
     throw InputError("loads/tool: radius and depth must be > 0 when the tool is enabled");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "msfem/cases/errors.hpp"
@@ -37,6 +38,38 @@ nlohmann::json variant_parameters(const massspring::MassSpringModel& model) {
           {"constrained_nodes", model.constrained_nodes().size()}};
 }
 
+std::string millimetres(double metres) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g mm", metres * 1e3);
+  return text;
+}
+
+// Why a variant's force falls with depth, with the evidence where the variant has volume elements:
+// edge springs keep a tetrahedron's edge lengths but not its orientation, so one turned inside out
+// costs nothing more than its mirror image and the network gives way under the tool.
+std::string force_falls_warning(const std::vector<ForceDepthPoint>& curve, Eigen::Index elements) {
+  std::string why =
+      "the reaction force does not grow with depth along the loading path: the network buckles or "
+      "snaps under the tool";
+  const auto first_inverted = std::find_if(curve.begin(), curve.end(), [](const auto& pt) {
+    return pt.inverted_elements.value_or(0) > 0;
+  });
+  if (first_inverted != curve.end()) {
+    const auto worst =
+        std::max_element(curve.begin(), curve.end(), [](const auto& a, const auto& b) {
+          return a.inverted_elements.value_or(0) < b.inverted_elements.value_or(0);
+        });
+    why += " (" + std::to_string(*first_inverted->inverted_elements) + " of " +
+           std::to_string(elements) + " tetrahedra are inverted at " +
+           millimetres(first_inverted->depth_m) + ", " + std::to_string(*worst->inverted_elements) +
+           " at " + millimetres(worst->depth_m) +
+           ": edge springs do not resist a tetrahedron turning inside out)";
+  } else {
+    why += " (a spring network has no resistance to inverted elements)";
+  }
+  return why + ", so its force-depth curve is not one a haptic device should render";
+}
+
 }  // namespace
 
 void Progress::stage(const std::string& what) const {
@@ -53,6 +86,24 @@ void Progress::advance(const std::string& what, int done, int total, double elap
 std::vector<double> curve_depths(const cases::ToolParameters& tool) {
   if (!tool.curve_depths_m.empty()) return tool.curve_depths_m;
   return {0.25 * tool.depth_m, 0.5 * tool.depth_m, 0.75 * tool.depth_m, tool.depth_m};
+}
+
+std::vector<double> loading_path(std::vector<double> depths, double case_depth, double step) {
+  depths.push_back(case_depth);
+  std::sort(depths.begin(), depths.end());
+  depths.erase(std::unique(depths.begin(), depths.end()), depths.end());
+  if (!(step > 0)) return depths;
+  std::vector<double> path;
+  double last = 0.0;
+  for (double d : depths) {
+    // Equal increments no longer than `step`; the recorded depth itself stays exact.
+    const int pieces = static_cast<int>(std::ceil((d - last) / step - 1e-9));
+    for (int i = 1; i < pieces; ++i)
+      path.push_back(last + (d - last) * i / pieces);
+    path.push_back(d);
+    last = d;
+  }
+  return path;
 }
 
 std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,
@@ -142,31 +193,32 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       StaticSolution s;
       if (depths.empty()) {
         s = solve_variant_static(built);
+        r.inverted_elements = inverted_tetrahedra(built, s.x);
       } else {
         // A quasi-static loading path, each depth started from the last, as a tool pressed in steps
         // is: a network with several equilibria (one that buckles under the tool) then stays on the
         // branch a simulator would follow, and the curve is the force a haptic device would render.
-        std::vector<double> path = depths;
-        path.push_back(tool->depth);
-        std::sort(path.begin(), path.end());
-        path.erase(std::unique(path.begin(), path.end()), path.end());
+        const std::vector<double> path =
+            loading_path(depths, tool->depth, parameters.loads.tool.path_step_m);
         Eigen::VectorXd x;
         for (double depth : path) {
           set_tool_depth(built, at_depth(*tool, depth));
           StaticSolution at = solve_variant_static(built, x);
           x = at.x;
-          if (std::find(depths.begin(), depths.end(), depth) != depths.end())
-            r.force_depth.push_back({depth, at.tool_force});
-          if (depth == tool->depth) s = std::move(at);
+          const std::optional<int> inverted = inverted_tetrahedra(built, at.x);
+          // Every step of the path is a point of the variant's curve: a fall between two curve
+          // depths must not go unseen.
+          r.force_depth.push_back({depth, at.tool_force, inverted});
+          if (depth == tool->depth) {
+            s = std::move(at);
+            r.inverted_elements = inverted;
+          }
         }
         set_tool_depth(built, *tool);
       }
       r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
       if (r.force_depth_monotone == false)
-        r.warnings.push_back(
-            "the reaction force does not grow with depth along the loading path: the network "
-            "buckles or snaps under the tool (a spring network has no resistance to inverted "
-            "elements), so its force-depth curve is not one a haptic device should render");
+        r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
       r.newton_iterations = s.newton_iterations;
       r.surface_displacement = s.surface_displacement;
       r.error = s.surface_displacement - run.fem.surface_displacement;

@@ -17,8 +17,9 @@ nlohmann::json vec(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
 }
 
-nlohmann::json optional_json(const std::optional<bool>& b) {
-  return b ? nlohmann::json(*b) : nlohmann::json();
+template <class T>
+nlohmann::json optional_json(const std::optional<T>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json();
 }
 
 nlohmann::json zone(const ErrorMetrics& m) {
@@ -87,7 +88,9 @@ nlohmann::json summary_json(const CaseRun& run) {
   for (const auto& v : run.variants) {
     nlohmann::json fd = nlohmann::json::array();
     for (const auto& pt : v.force_depth)
-      fd.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
+      fd.push_back({{"depth_m", pt.depth_m},
+                    {"force_N", vec(pt.force_n)},
+                    {"inverted_elements", optional_json(pt.inverted_elements)}});
     variants.push_back({{"name", v.name},
                         {"nodes", v.nodes},
                         {"springs", v.springs},
@@ -114,6 +117,7 @@ nlohmann::json summary_json(const CaseRun& run) {
                         {"newton_iterations", v.newton_iterations},
                         {"force_depth", fd},
                         {"force_depth_monotone", optional_json(v.force_depth_monotone)},
+                        {"inverted_elements", optional_json(v.inverted_elements)},
                         {"warnings", v.warnings},
                         {"parameters", v.parameters}});
   }

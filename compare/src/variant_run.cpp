@@ -131,6 +131,23 @@ void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool) {
   // listed after the tool but a tool on a fixed node is refused by make_problem).
 }
 
+std::optional<int> inverted_tetrahedra(const BuiltVariant& variant, const Eigen::VectorXd& x) {
+  if (variant.tetrahedra.rows() == 0) return std::nullopt;
+  const auto& rest = variant.model->network().rest_positions;
+  auto signed_volume = [&](auto&& position, Eigen::Index t) {
+    const Eigen::Vector3d a = position(variant.tetrahedra(t, 0));
+    return (position(variant.tetrahedra(t, 1)) - a)
+        .cross(position(variant.tetrahedra(t, 2)) - a)
+        .dot(position(variant.tetrahedra(t, 3)) - a);
+  };
+  const auto at_rest = [&](int n) -> Eigen::Vector3d { return rest.row(n).transpose(); };
+  const auto moved = [&](int n) -> Eigen::Vector3d { return x.segment<3>(3 * n); };
+  int inverted = 0;
+  for (Eigen::Index t = 0; t < variant.tetrahedra.rows(); ++t)
+    if (signed_volume(moved, t) * signed_volume(at_rest, t) <= 0.0) ++inverted;
+  return inverted;
+}
+
 BuiltVariant build_variant(const std::string& name, const Problem& problem,
                            const fem_reference::VolumeMesh& mesh,
                            const std::optional<ToolPlacement>& tool) {
@@ -140,6 +157,7 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
   variant.case_surface_vertices = problem.surface.num_vertices();
   try {
     ms::SpringNetwork network = build_network(name, problem, mesh);
+    if (name == "tet_edges") variant.tetrahedra = mesh.tetrahedra;
     variant.warnings = network.warnings;
     variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
     ms::MassSpringModel& model = *variant.model;

@@ -48,6 +48,28 @@ class RunSmallSphere : public ::testing::Test {
 TemporaryDirectory* RunSmallSphere::dir_ = nullptr;
 testing::CommandResult* RunSmallSphere::result_ = nullptr;
 
+// The per-variant keys summary.json documents (docs/harness.md).
+const char* const kVariantKeys[] = {"name",
+                                    "nodes",
+                                    "springs",
+                                    "rel_l2_error",
+                                    "rms_error_m",
+                                    "max_error_m",
+                                    "mean_error_over_max_disp",
+                                    "contact_zone",
+                                    "far_field",
+                                    "reaction_force_N",
+                                    "reaction_force_rel_error",
+                                    "volume_change",
+                                    "steps_per_second",
+                                    "stable_dt_s",
+                                    "realtime_factor",
+                                    "settle_time_s",
+                                    "ms_per_60hz_frame",
+                                    "parameters",
+                                    "force_depth_monotone",
+                                    "inverted_elements"};
+
 TEST_F(RunSmallSphere, SummaryHasTheDocumentedSchemaAndFiniteNumbers) {
   ASSERT_EQ(result_->exit_code, 0) << result_->err;
   EXPECT_NE(result_->out.find("| three_tier"), std::string::npos) << result_->out;
@@ -59,11 +81,7 @@ TEST_F(RunSmallSphere, SummaryHasTheDocumentedSchemaAndFiniteNumbers) {
     EXPECT_TRUE(j["fem"].contains(key)) << key;
   ASSERT_EQ(j["variants"].size(), 4u);
   for (const auto& v : j["variants"]) {
-    for (const char* key :
-         {"name", "nodes", "springs", "rel_l2_error", "rms_error_m", "max_error_m",
-          "mean_error_over_max_disp", "contact_zone", "far_field", "reaction_force_N",
-          "reaction_force_rel_error", "volume_change", "steps_per_second", "stable_dt_s",
-          "realtime_factor", "settle_time_s", "ms_per_60hz_frame", "parameters"})
+    for (const char* key : kVariantKeys)
       EXPECT_TRUE(v.contains(key)) << v["name"] << " lacks " << key;
     for (const char* zone : {"contact_zone", "far_field"}) {
       EXPECT_TRUE(v[zone].contains("rel_l2_error"));
@@ -195,6 +213,29 @@ TEST(CliRun, AVariantThatFailsIsReportedAndTheOthersAreStillCompared) {
     EXPECT_TRUE(std::isfinite(v["rel_l2_error"].get<double>()));
   }
   EXPECT_NE(read_text(out / "report.md").find("tet_edges failed"), std::string::npos);
+}
+
+TEST(CliRun, PathStepsArePointsOfEachVariantsCurveAndTheLastIsTheTablesRow) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "run";
+  const auto r = run_msfem("run " + small_case +
+                           " --quiet --no-timing --set \"loads/tool/path step=0.0005\" --set "
+                           "\"mass spring/variants=tet_edges,three_tier\" --out " +
+                           out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(j["fem"]["force_depth"].size(), 2u);  // the FEM at the curve depths only
+  ASSERT_EQ(j["variants"].size(), 2u);
+  for (const auto& v : j["variants"]) {
+    const auto& curve = v["force_depth"];
+    ASSERT_EQ(curve.size(), 8u) << v["name"];  // 0.5, 1, ..., 4 mm
+    for (std::size_t i = 0; i < curve.size(); ++i)
+      EXPECT_NEAR(curve[i]["depth_m"].get<double>(), 0.0005 * (i + 1), 1e-15);
+    EXPECT_EQ(curve.back()["force_N"], v["reaction_force_N"]) << v["name"];
+    const bool volumetric = v["name"] == "tet_edges";
+    EXPECT_EQ(v["inverted_elements"].is_number_integer(), volumetric) << v["name"];
+    EXPECT_EQ(curve.back()["inverted_elements"], v["inverted_elements"]) << v["name"];
+  }
 }
 
 TEST(CliParams, PrintsTheWholeLanguage) {

@@ -54,6 +54,8 @@ struct ToolParameters {
   double depth_m = 0.005;
   /// Depths of the force-depth curve (empty: depth/4, depth/2, 3 depth/4, depth).
   std::vector<double> curve_depths_m;
+  /// Largest depth increment of the spring variants' loading path (0: the curve depths only).
+  double path_step_m = 0.0;
 };
 
 /// A total force spread over the surface vertices within radius of the point farthest along

@@ -33,6 +33,7 @@ class Progress {
 struct ForceDepthPoint {
   double depth_m = 0.0;
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  std::optional<int> inverted_elements;  ///< a volumetric variant's inverted tetrahedra there
 };
 
 struct VariantResult {
@@ -50,6 +51,7 @@ struct VariantResult {
   Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
   std::vector<ForceDepthPoint> force_depth;
   std::optional<bool> force_depth_monotone;  ///< none without a curve
+  std::optional<int> inverted_elements;      ///< at the case's load; none for surface networks
 };
 
 struct CaseRun {
@@ -82,6 +84,10 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 
 /// Force-depth depths of a tool: the case's list, or a quarter, half, three quarters and all of it.
 std::vector<double> curve_depths(const cases::ToolParameters& tool);
+
+/// The spring variants' quasi-static loading path: the curve depths and the case's depth in
+/// increasing order, with equal steps no longer than `step` (> 0) inserted from 0 up to each.
+std::vector<double> loading_path(std::vector<double> depths, double case_depth, double step);
 
 /// Whether the force the tissue exerts on the tool, along the tool's outward normal, grows strictly
 /// from each depth of the curve to the next deeper one; none without a tool or with fewer than

@@ -28,6 +28,10 @@ struct BuiltVariant {
   /// The case's surface vertices are the first this many surface nodes (tet_edges on the FEM's
   /// mesh refined at the tool has more; only these are compared).
   Eigen::Index case_surface_vertices = 0;
+  /// The volume elements whose edges are the springs (tet_edges; empty for the other variants),
+  /// node indices of the model: a spring network has no resistance to their inversion, so runs
+  /// count the inverted ones.
+  Eigen::MatrixX4i tetrahedra;
   std::vector<std::string> warnings;
 };
 BuiltVariant build_variant(const std::string& name, const Problem& problem,
@@ -36,6 +40,10 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
 
 /// Moves the tool of an already built variant to another depth (the force-depth curve).
 void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool);
+
+/// How many of the variant's tetrahedra the node-major positions `x` turn inside out (signed volume
+/// of the other sign than at rest); none when the variant has no volume elements.
+std::optional<int> inverted_tetrahedra(const BuiltVariant& variant, const Eigen::VectorXd& x);
 
 struct StaticSolution {
   Eigen::VectorXd x;                                     ///< node-major positions at equilibrium

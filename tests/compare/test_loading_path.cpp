@@ -1,0 +1,69 @@
+#include <gtest/gtest.h>
+
+#include "msfem/compare/case_run.hpp"
+#include "msfem/compare/variant_run.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+
+namespace msfem::compare {
+namespace {
+
+TEST(LoadingPath, WithoutAStepItIsTheSortedDistinctDepths) {
+  EXPECT_EQ(loading_path({0.004, 0.002}, 0.004, 0.0), (std::vector<double>{0.002, 0.004}));
+  EXPECT_EQ(loading_path({0.002}, 0.003, 0.0), (std::vector<double>{0.002, 0.003}));
+}
+
+TEST(LoadingPath, StepsAreEqualWithinEachIntervalNoLongerThanAskedAndKeepTheRecordedDepths) {
+  const std::vector<double> path = loading_path({0.002, 0.004}, 0.004, 0.0007);
+  // 0..2 mm in 3 steps (0.667 mm), 2..4 mm in 3 steps.
+  ASSERT_EQ(path.size(), 6u);
+  EXPECT_EQ(path[2], 0.002);
+  EXPECT_EQ(path[5], 0.004);
+  double last = 0.0;
+  for (double d : path) {
+    EXPECT_GT(d - last, 0.0);
+    EXPECT_LE(d - last, 0.0007 + 1e-15);
+    last = d;
+  }
+  EXPECT_NEAR(path[0], 0.002 / 3, 1e-15);
+  EXPECT_NEAR(path[3] - path[2], 0.002 / 3, 1e-15);
+  // A step that divides an interval exactly adds no sliver step.
+  EXPECT_EQ(loading_path({0.002, 0.004}, 0.004, 0.0005).size(), 8u);
+  // A step longer than every interval changes nothing.
+  EXPECT_EQ(loading_path({0.002, 0.004}, 0.004, 0.01), (std::vector<double>{0.002, 0.004}));
+}
+
+BuiltVariant one_tetrahedron() {
+  Eigen::MatrixX3d v(4, 3);
+  v << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  Eigen::MatrixX4i t(1, 4);
+  t << 0, 1, 2, 3;
+  BuiltVariant b;
+  b.name = "tet_edges";
+  b.model = std::make_unique<massspring::MassSpringModel>(massspring::build_tet_edges(v, t));
+  b.tetrahedra = t;
+  return b;
+}
+
+TEST(InvertedTetrahedra, CountsAnElementTurnedInsideOutNotOneMerelySquashedOrMoved) {
+  const BuiltVariant b = one_tetrahedron();
+  Eigen::VectorXd x(12);
+  x << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  EXPECT_EQ(inverted_tetrahedra(b, x), 0);
+  x[11] = 0.05;  // flattened but the same way up
+  EXPECT_EQ(inverted_tetrahedra(b, x), 0);
+  x[11] = -1.0;  // the apex through its base: every spring keeps its length
+  EXPECT_EQ(inverted_tetrahedra(b, x), 1);
+  EXPECT_NEAR(b.model->potential_energy(x), 0.0, 1e-12)
+      << "a mirrored tetrahedron costs edge springs nothing";
+  x.array() += 3.0;  // a rigid translation changes nothing
+  EXPECT_EQ(inverted_tetrahedra(b, x), 1);
+}
+
+TEST(InvertedTetrahedra, NoneForAVariantWithoutVolumeElements) {
+  BuiltVariant b = one_tetrahedron();
+  b.tetrahedra.resize(0, 4);
+  EXPECT_FALSE(inverted_tetrahedra(b, Eigen::VectorXd::Zero(12)).has_value());
+}
+
+}  // namespace
+}  // namespace msfem::compare
