@@ -66,19 +66,24 @@ void naive_step(benchmark::State& state, const std::string& name) {
   annotate(state, model, 1);
 }
 
+// threads 2 with adaptive_threads (the default) may step on one thread while that is faster;
+// the counter `threads` is the mean number the steps ran on.
 void implicit_step(benchmark::State& state, const std::string& name, bool single_precision,
-                   double tolerance) {
+                   double tolerance, int threads, bool adaptive_threads) {
   const MassSpringModel& model = model_for(name);
-  FastImplicitStepper stepper(model, FastImplicitOptions{2, true, tolerance, 50, single_precision});
+  FastImplicitOptions options{threads, true, tolerance, 50, single_precision, adaptive_threads};
+  FastImplicitStepper stepper(model, options);
   stepper.set_state(perturbed_start(model));
-  long iterations = 0;
+  long iterations = 0, thread_steps = 0;
   for (auto _ : state) {
     stepper.step(1e-3);
     iterations += stepper.last_cg_iterations();
+    thread_steps += stepper.last_step_threads();
   }
   annotate(state, model, 1);
-  state.counters["cg_iterations"] =
-      static_cast<double>(iterations) / static_cast<double>(std::max<long>(state.iterations(), 1));
+  const double steps = static_cast<double>(std::max<long>(state.iterations(), 1));
+  state.counters["cg_iterations"] = static_cast<double>(iterations) / steps;
+  state.counters["threads"] = static_cast<double>(thread_steps) / steps;
 }
 
 void register_all() {
@@ -109,14 +114,23 @@ void register_all() {
     for (const double tolerance : {1e-3, 1e-2}) {
       const std::string tag = tolerance == 1e-3 ? "tol1e-3" : "tol1e-2";
       benchmark::RegisterBenchmark(("implicit_double_2threads_" + tag + "/" + name).c_str(),
-                                   implicit_step, name, false, tolerance)
+                                   implicit_step, name, false, tolerance, 2, true)
           ->UseRealTime()
           ->Unit(benchmark::kMicrosecond);
       benchmark::RegisterBenchmark(("implicit_float_2threads_" + tag + "/" + name).c_str(),
-                                   implicit_step, name, true, tolerance)
+                                   implicit_step, name, true, tolerance, 2, true)
           ->UseRealTime()
           ->Unit(benchmark::kMicrosecond);
     }
+    // The haptic float step pinned to two threads and on one, beside the adaptive one above.
+    benchmark::RegisterBenchmark(("implicit_float_2threads_fixed_tol1e-2/" + name).c_str(),
+                                 implicit_step, name, true, 1e-2, 2, false)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("implicit_float_1thread_tol1e-2/" + name).c_str(), implicit_step,
+                                 name, true, 1e-2, 1, false)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond);
   }
 }
 

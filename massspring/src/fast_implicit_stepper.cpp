@@ -4,6 +4,7 @@
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "gather_kernels.hpp"
@@ -20,6 +21,7 @@ class FastImplicitStepper::Implementation {
   virtual State state() const = 0;
   virtual void step(double h) = 0;
   virtual int last_iterations() const = 0;
+  virtual int last_threads() const = 0;
   virtual int num_nodes() const = 0;
   virtual int num_springs() const = 0;
 };
@@ -38,25 +40,31 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         soa_(model, options.reorder_nodes),
         gather_(soa_),
         records_(kRecord * (soa_.num_nodes + 2)),
-        p_records_(detail::kDirection * (soa_.num_nodes + 2)) {
+        p_records_(detail::kDirection * (soa_.num_nodes + 2)),
+        dv_records_(detail::kDirection * (soa_.num_nodes + 2)) {
     const std::size_t lanes = gather_.lane_node.size();
     system_.resize(gather_.chunk_slot.back(), lanes);
     for (int c = 0; c < 3; ++c)
-      for (auto* v : {&dv_[c], &residual_[c], &direction_[c], &product_[c]}) {
+      for (auto* v :
+           {&dv_[c], &residual_[c], &u_[c], &w_[c], &direction_[c], &direction_product_[c]}) {
         v->assign(lanes, Real(0));
         cg_.dv[c] = dv_[c].data();
         cg_.r[c] = residual_[c].data();
-        cg_.p[c] = direction_[c].data();
-        cg_.y[c] = product_[c].data();
+        cg_.p[c] = u_[c].data();  // what the products read: u = B⁻¹ r
+        cg_.y[c] = w_[c].data();  // w = A u
+        direction_pointers_[c] = direction_[c].data();
+        direction_product_pointers_[c] = direction_product_[c].data();
       }
     for (int e = 0; e < 6; ++e) {
       inverse_block_[e].assign(lanes, Real(0));
       cg_.inverse_block[e] = inverse_block_[e].data();
     }
     // Equal shares of the layout's blocks of chunks (about equal slot counts).
-    const int blocks = static_cast<int>(gather_.block_begin.size()) - 1;
     for (int m = 0; m <= team_.size(); ++m)
-      chunk_begin_.push_back(gather_.block_begin[static_cast<long>(blocks) * m / team_.size()]);
+      member_block_.push_back(static_cast<int>(static_cast<long>(blocks()) * m / team_.size()));
+    for (auto& sums : block_sums_)
+      sums.assign(3 * static_cast<std::size_t>(blocks()), 0.0);
+    current_members_ = team_.size();
     pack();
   }
 
@@ -82,6 +90,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     return out;
   }
   int last_iterations() const override { return last_iterations_; }
+  int last_threads() const override { return last_members_; }
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
 
@@ -90,62 +99,113 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   void step(double dt) override {
     check_time_step(dt);
     const Real h = static_cast<Real>(dt);
+    const int members = choose_members();
+    const auto start = std::chrono::steady_clock::now();
     int iterations = 0;
     const std::function<void(int)> job = [&](int member) {
-      const int c0 = chunk_begin_[member], c1 = chunk_begin_[member + 1];
-      // The direction records hold Δv of the last step (cg_advance): the warm start r = b - A Δv.
-      kernels_.linearise(gather_, records_.data(), system_, cg_, c0, c1, h);
-      kernels_.product(gather_, system_, p_records_.data(), cg_.dv, cg_.y, c0, c1);
-      team_.barrier();  // every product has read Δv's records before they are overwritten
-      double sums[3];   // r·z, r·r, b·b
-      kernels_.cg_start(gather_, system_, cg_, p_records_.data(), c0, c1, sums);
-      reduce(member, sums);  // its barrier also completes the direction records
-      double rz = sums[0], rr = sums[1];
+      const int b0 = members == 1 ? 0 : member_block_[member];
+      const int b1 = members == 1 ? blocks() : member_block_[member + 1];
+      int parity = 0;
+      // Runs a kernel over this member's blocks, then sums the per-block values over all blocks
+      // in block order (the same sums for any number of members).
+      auto reduced = [&](auto kernel, double(&values)[3]) {
+        for (int block = b0; block < b1; ++block) {
+          double* sums = &block_sums_[parity][3 * block];
+          kernel(gather_.block_begin[block], gather_.block_begin[block + 1], sums);
+        }
+        if (members > 1) team_.barrier();
+        for (int k = 0; k < 3; ++k) {
+          values[k] = 0.0;
+          for (int block = 0; block < blocks(); ++block)
+            values[k] += block_sums_[parity][3 * block + k];
+        }
+        // Two alternating buffers: one is written again only after every member has passed the
+        // barrier of the other.
+        parity ^= 1;
+      };
+      // One pass: linearise, and start CG from the warm start (the last step's Δv, cg_advance).
+      double sums[3];  // r·u, r·r, b·b; the barrier also completes the u records
+      reduced(
+          [&](int c0, int c1, double* out) {
+            double local[3];
+            kernels_.linearise_start(gather_, records_.data(), dv_records_.data(), system_, cg_,
+                                     p_records_.data(), c0, c1, h, local);
+            std::copy(local, local + 3, out);
+          },
+          sums);
+      double gamma = sums[0], rr = sums[1], alpha = 0.0, previous_gamma = 0.0;
       const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
       int iteration = 0;
       while (iteration < options_.cg_max_iterations && rr > target) {
-        double pap[3] = {
-            kernels_.product(gather_, system_, p_records_.data(), cg_.p, cg_.y, c0, c1), 0.0, 0.0};
-        reduce(member, pap);
-        if (!(pap[0] > 0.0)) break;
-        double next[3];
-        kernels_.cg_update(cg_, static_cast<Real>(rz / pap[0]), c0, c1, next);
-        reduce(member, next);
-        const Real ratio = static_cast<Real>(next[0] / rz);
-        rz = next[0];
+        double delta[3];  // u·A u
+        reduced(
+            [&](int c0, int c1, double* out) {
+              out[0] = kernels_.product(gather_, system_, p_records_.data(), cg_.p, cg_.y, c0, c1);
+              out[1] = out[2] = 0.0;
+            },
+            delta);
+        // Chronopoulos-Gear: d·A d = δ - β γ / α_previous, so one reduction per product.
+        const double beta = iteration == 0 ? 0.0 : gamma / previous_gamma;
+        const double curvature = iteration == 0 ? delta[0] : delta[0] - beta * gamma / alpha;
+        if (!(curvature > 0.0)) break;
+        alpha = gamma / curvature;
+        double next[3];  // r·u, r·r; the barrier also completes the u records
+        reduced(
+            [&](int c0, int c1, double* out) {
+              double local[3];
+              kernels_.cg_iterate(gather_, cg_, direction_pointers_, direction_product_pointers_,
+                                  p_records_.data(), static_cast<Real>(alpha),
+                                  static_cast<Real>(beta), c0, c1, local);
+              std::copy(local, local + 3, out);
+            },
+            next);
+        previous_gamma = gamma;
+        gamma = next[0];
         rr = next[1];
-        kernels_.cg_direction(gather_, cg_, p_records_.data(), ratio, c0, c1);
-        team_.barrier();  // directions complete before the next product reads them
         ++iteration;
       }
-      // No barrier: every product of this step has ended at the last reduce or barrier.
-      kernels_.cg_advance(gather_, cg_, records_.data(), p_records_.data(), c0, c1, h);
+      // No barrier: every product of this step has ended at the last reduction, and the next
+      // step's first pass reads the records after the step returns.
+      kernels_.cg_advance(gather_, cg_, records_.data(), dv_records_.data(),
+                          gather_.block_begin[b0], gather_.block_begin[b1], h);
       if (member == 0) iterations = iteration;
     };
-    team_.run(job);
+    if (members == 1)
+      job(0);
+    else
+      team_.run(job);
     last_iterations_ = iterations;
     time_ += dt;
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+    record_time(members, took.count() / (iterations + 2.0));
   }
 
  private:
-  // Sums per-member values over the team; every member gets the same totals. Two alternating
-  // buffers: a member can only reuse one after everyone has passed the barrier of the other.
-  void reduce(int member, double (&values)[3]) {
-    double* mine = partial_[parity_[member]] + 3 * member;
-    for (int k = 0; k < 3; ++k)
-      mine[k] = values[k];
-    team_.barrier();
-    const double* all = partial_[parity_[member]];
-    for (int k = 0; k < 3; ++k) {
-      values[k] = 0.0;
-      for (int m = 0; m < team_.size(); ++m)
-        values[k] += all[3 * m + k];
+  int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
+
+  // With adaptive_threads, steps run on the whole team or on the calling thread alone, whichever
+  // took less time per product lately: runs of kPeriod steps, each followed by kProbe steps the
+  // other way; a probe 10 % faster than the run's last kProbe steps switches.
+  static constexpr int kPeriod = 64, kProbe = 4;
+  int choose_members() const {
+    if (team_.size() == 1 || !options_.adaptive_threads) return team_.size();
+    const int other = current_members_ == 1 ? team_.size() : 1;
+    return steps_ % (kPeriod + kProbe) < kPeriod ? current_members_ : other;
+  }
+  void record_time(int members, double seconds_per_product) {
+    last_members_ = members;
+    const long position = steps_++ % (kPeriod + kProbe);
+    if (team_.size() == 1 || !options_.adaptive_threads) return;
+    if (position >= kPeriod - kProbe && position < kPeriod) current_time_ += seconds_per_product;
+    if (position >= kPeriod) probe_time_ += seconds_per_product;
+    if (position == kPeriod + kProbe - 1) {
+      if (probe_time_ < 0.9 * current_time_) current_members_ = members;
+      current_time_ = probe_time_ = 0.0;
     }
-    parity_[member] ^= 1;
   }
 
-  // The node records from the layout's arrays. The direction records keep Δv for the next warm
-  // start (zero at construction, as Δv is).
+  // The node records from the layout's arrays. The Δv records keep Δv for the next warm start
+  // (zero at construction, as Δv is).
   void pack() {
     std::fill(records_.data(), records_.data() + records_.size(), Real(0));
     for (int c = 0; c < 3; ++c)
@@ -170,15 +230,22 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::SoaLayout<Real> soa_;
   detail::NodeGatherLayout<Real, W> gather_;
   detail::Kernels<Real, W> kernels_;
-  detail::AlignedVector<Real> records_;    // x, v per node
-  detail::AlignedVector<Real> p_records_;  // CG direction per node (zero on constrained nodes)
+  detail::AlignedVector<Real> records_;     // x, v per node
+  detail::AlignedVector<Real> p_records_;   // u = B⁻¹ r per node (zero on constrained nodes)
+  detail::AlignedVector<Real> dv_records_;  // the last step's Δv per node (zero on constrained)
   detail::ImplicitCoefficients<Real> system_;
-  detail::AlignedVector<Real> dv_[3], residual_[3], direction_[3], product_[3];  // product_: z too
+  // CG vectors in lane order: Δv, r, u = B⁻¹ r, w = A u, the direction d and s = A d.
+  detail::AlignedVector<Real> dv_[3], residual_[3], u_[3], w_[3], direction_[3],
+      direction_product_[3];
+  Real* direction_pointers_[3];
+  Real* direction_product_pointers_[3];
   detail::AlignedVector<Real> inverse_block_[6];
   detail::CgVectors<Real> cg_;
-  std::vector<int> chunk_begin_;
-  double partial_[2][3 * 64] = {};
-  int parity_[64] = {};
+  std::vector<int> member_block_;      // the members' first blocks, then the number of blocks
+  std::vector<double> block_sums_[2];  // per block of chunks: three partial sums
+  int current_members_ = 1, last_members_ = 1;
+  long steps_ = 0;
+  double current_time_ = 0.0, probe_time_ = 0.0;
   double time_ = 0.0;
   int last_iterations_ = 0;
 };
@@ -212,6 +279,9 @@ void FastImplicitStepper::step(double dt) {
 }
 int FastImplicitStepper::last_cg_iterations() const {
   return impl_->last_iterations();
+}
+int FastImplicitStepper::last_step_threads() const {
+  return impl_->last_threads();
 }
 int FastImplicitStepper::num_nodes() const {
   return impl_->num_nodes();

@@ -177,32 +177,36 @@ class Kernels {
         return explicit_step_for<SpringDamping::per_spring>(g, cur, next, begin, end, h);
     }
   }
-  void linearise(const NodeGatherLayout<Real, W>& g, const Real* records,
-                 ImplicitCoefficients<Real>& sys, const CgVectors<Real>& cg, int begin, int end,
-                 Real h) const {
-    MSFEM_DISPATCH(linearise_chunks, g, records, sys, cg, begin, end, h);
+  void linearise_start(const NodeGatherLayout<Real, W>& g, const Real* records,
+                       const Real* dv_records, ImplicitCoefficients<Real>& sys,
+                       const CgVectors<Real>& cg, Real* p_records, int begin, int end, Real h,
+                       double (&sums)[3]) const {
+    switch (g.spring_damping) {
+      case SpringDamping::none:
+        return linearise_start_for<SpringDamping::none>(g, records, dv_records, sys, cg, p_records,
+                                                        begin, end, h, sums);
+      case SpringDamping::uniform:
+        return linearise_start_for<SpringDamping::uniform>(g, records, dv_records, sys, cg,
+                                                           p_records, begin, end, h, sums);
+      default:
+        return linearise_start_for<SpringDamping::per_spring>(g, records, dv_records, sys, cg,
+                                                              p_records, begin, end, h, sums);
+    }
   }
   void cg_advance(const NodeGatherLayout<Real, W>& g, const CgVectors<Real>& cg, Real* records,
-                  Real* p_records, int begin, int end, Real h) const {
-    MSFEM_DISPATCH(cg_advance_chunks, g, cg, records, p_records, begin, end, h);
+                  Real* dv_records, int begin, int end, Real h) const {
+    MSFEM_DISPATCH(cg_advance_chunks, g, cg, records, dv_records, begin, end, h);
   }
   double product(const NodeGatherLayout<Real, W>& g, const ImplicitCoefficients<Real>& sys,
                  const Real* p_records, Real* const (&p)[3], Real* const (&y)[3], int begin,
                  int end) const {
     MSFEM_DISPATCH(product_chunks, g, sys, p_records, p, y, begin, end);
   }
-  void cg_start(const NodeGatherLayout<Real, W>& g, const ImplicitCoefficients<Real>& sys,
-                const CgVectors<Real>& cg, Real* p_records, int begin, int end,
-                double (&sums)[3]) const {
-    MSFEM_DISPATCH(cg_start_chunks, g, sys, cg, p_records, begin, end, sums);
-  }
-  void cg_update(const CgVectors<Real>& cg, Real step_length, int begin, int end,
-                 double (&sums)[3]) const {
-    MSFEM_DISPATCH(cg_update_chunks, cg, step_length, begin, end, sums);
-  }
-  void cg_direction(const NodeGatherLayout<Real, W>& g, const CgVectors<Real>& cg, Real* p_records,
-                    Real ratio, int begin, int end) const {
-    MSFEM_DISPATCH(cg_direction_chunks, g, cg, p_records, ratio, begin, end);
+  void cg_iterate(const NodeGatherLayout<Real, W>& g, const CgVectors<Real>& cg,
+                  Real* const (&direction)[3], Real* const (&direction_product)[3], Real* u_records,
+                  Real alpha, Real beta, int begin, int end, double (&sums)[3]) const {
+    MSFEM_DISPATCH(cg_iterate_chunks, g, cg, direction, direction_product, u_records, alpha, beta,
+                   begin, end, sums);
   }
 
  private:
@@ -221,6 +225,24 @@ class Kernels {
     }
 #endif
     return explicit_chunks_portable<PortableLanes<Real, W>, Damped>(g, cur, next, begin, end, h);
+  }
+  template <SpringDamping Damped>
+  void linearise_start_for(const NodeGatherLayout<Real, W>& g, const Real* records,
+                           const Real* dv_records, ImplicitCoefficients<Real>& sys,
+                           const CgVectors<Real>& cg, Real* p_records, int begin, int end, Real h,
+                           double (&sums)[3]) const {
+#if MSFEM_HAVE_X86_DISPATCH
+    if constexpr (W == 16) {
+      return linearise_start_chunks_avx512<Avx512Float, Damped>(g, records, dv_records, sys, cg,
+                                                                p_records, begin, end, h, sums);
+    } else if constexpr (W == 32 / sizeof(Real)) {
+      if (avx2_)
+        return linearise_start_chunks_avx2<Avx2<Real>, Damped>(g, records, dv_records, sys, cg,
+                                                               p_records, begin, end, h, sums);
+    }
+#endif
+    return linearise_start_chunks_portable<PortableLanes<Real, W>, Damped>(
+        g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
   }
 
   bool avx2_;
