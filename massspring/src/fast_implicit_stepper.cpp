@@ -184,22 +184,26 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
 
   // With adaptive_threads, steps run on the whole team or on the calling thread alone, whichever
-  // took less time per product lately: runs of kPeriod steps, each followed by kProbe steps the
-  // other way; a probe 10 % faster than the run's last kProbe steps switches.
-  static constexpr int kPeriod = 64, kProbe = 4;
+  // took less time per product lately: runs of period_ steps, each followed by kProbe steps the
+  // other way; a probe 10 % faster than the run's last kProbe steps switches. The period doubles
+  // after each probe that does not switch (up to kMaxPeriod: the probes' cost on a steady machine
+  // stays near 1.5 %) and drops back to kMinPeriod after a switch.
+  static constexpr int kMinPeriod = 32, kMaxPeriod = 256, kProbe = 4;
   int choose_members() const {
     if (team_.size() == 1 || !options_.adaptive_threads) return team_.size();
     const int other = current_members_ == 1 ? team_.size() : 1;
-    return steps_ % (kPeriod + kProbe) < kPeriod ? current_members_ : other;
+    return run_ < period_ ? current_members_ : other;
   }
   void record_time(int members, double seconds_per_product) {
     last_members_ = members;
-    const long position = steps_++ % (kPeriod + kProbe);
     if (team_.size() == 1 || !options_.adaptive_threads) return;
-    if (position >= kPeriod - kProbe && position < kPeriod) current_time_ += seconds_per_product;
-    if (position >= kPeriod) probe_time_ += seconds_per_product;
-    if (position == kPeriod + kProbe - 1) {
-      if (probe_time_ < 0.9 * current_time_) current_members_ = members;
+    if (run_ >= period_ - kProbe && run_ < period_) current_time_ += seconds_per_product;
+    if (run_ >= period_) probe_time_ += seconds_per_product;
+    if (++run_ == period_ + kProbe) {
+      const bool faster = probe_time_ < 0.9 * current_time_;
+      if (faster) current_members_ = members;
+      period_ = faster ? kMinPeriod : std::min(2 * period_, kMaxPeriod);
+      run_ = 0;
       current_time_ = probe_time_ = 0.0;
     }
   }
@@ -243,8 +247,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::CgVectors<Real> cg_;
   std::vector<int> member_block_;      // the members' first blocks, then the number of blocks
   std::vector<double> block_sums_[2];  // per block of chunks: three partial sums
-  int current_members_ = 1, last_members_ = 1;
-  long steps_ = 0;
+  int current_members_ = 1, last_members_ = 1, run_ = 0, period_ = kMinPeriod;
   double current_time_ = 0.0, probe_time_ = 0.0;
   double time_ = 0.0;
   int last_iterations_ = 0;

@@ -21,8 +21,8 @@ struct FastImplicitOptions {
   bool single_precision = false;  ///< float arithmetic and wider vectors
   /// With threads > 1: step on the calling thread alone while that is faster (when other programs
   /// hold the cores, every one of a step's ~15 barriers waits for a pre-empted thread). Measured
-  /// per step, re-checked every 68 steps. Results do not depend on it: sums are taken per block
-  /// of nodes in a fixed order, for any number of threads.
+  /// per step, re-checked by 4 steps on the other count after every 32 to 256 steps. Results do not
+  /// depend on it: sums are taken per block of nodes in a fixed order, for any number of threads.
   bool adaptive_threads = true;
 };
 
