@@ -70,6 +70,43 @@ std::string force_falls_warning(const std::vector<ForceDepthPoint>& curve, Eigen
   return why + ", so its force-depth curve is not one a haptic device should render";
 }
 
+// The surface vertices that neither a support nor the tool prescribes: the ones compared.
+std::vector<int> unprescribed_vertices(const Problem& problem,
+                                       const std::optional<ToolPlacement>& tool) {
+  std::vector<int> free;
+  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
+  for (std::size_t v = 0; v < prescribed.size(); ++v)
+    if (!prescribed[v]) free.push_back(static_cast<int>(v));
+  if (free.empty())
+    throw cases::InputError(problem.parameters.file.string() +
+                            ": every surface vertex is prescribed");
+  return free;
+}
+
+// The variant's equilibrium with `tool` at its depth. With a path, a quasi-static loading path,
+// each depth started from the last, as a tool pressed in steps is: a network with several
+// equilibria (one that buckles under the tool) then stays on the branch a simulator would follow.
+// Every step is a point of `curve` (a fall between two curve depths must not go unseen). The path
+// ends at the tool's depth; the variant is left pressed there.
+StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& tool,
+                     const std::vector<double>& path, std::vector<ForceDepthPoint>& curve) {
+  if (!tool || path.empty()) {
+    if (tool) set_tool_depth(built, *tool);
+    return solve_variant_static(built);
+  }
+  StaticSolution s;
+  Eigen::VectorXd x;
+  for (double depth : path) {
+    set_tool_depth(built, at_depth(*tool, depth));
+    StaticSolution at = solve_variant_static(built, x);
+    x = at.x;
+    curve.push_back({depth, at.tool_force, inverted_tetrahedra(built, at.x)});
+    if (depth == tool->depth) s = std::move(at);
+  }
+  set_tool_depth(built, *tool);
+  return s;
+}
+
 }  // namespace
 
 void Progress::stage(const std::string& what) const {
@@ -136,10 +173,14 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 
   std::vector<double> depths;
   if (tool && settings.force_depth_curve) depths = curve_depths(parameters.loads.tool);
-  run.fem_cache_key = fem_cache_key(problem, depths);
+  const int other_tools =
+      settings.all_tools ? std::max(0, static_cast<int>(problem.tools.size()) - 1) : 0;
+  run.fem_cache_key = fem_cache_key(problem, depths, other_tools > 0);
   std::optional<FemCacheEntry> cached;
   if (settings.fem_cache_directory)
     cached = load_fem_cache(*settings.fem_cache_directory, run.fem_cache_key);
+  if (cached && static_cast<int>(cached->other_tools.size()) != other_tools) cached.reset();
+  std::vector<FemSolution> other_fem;
   if (cached) {
     progress.stage("FEM reference from the cache (" +
                    (*settings.fem_cache_directory / (run.fem_cache_key + ".cbor")).string() +
@@ -147,10 +188,12 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     run.mesh = std::move(cached->mesh);
     run.fem = std::move(cached->solution);
     run.fem_force_depth = std::move(cached->force_depth);
+    other_fem = std::move(cached->other_tools);
     run.fem_from_cache = true;
   } else {
     progress.stage("meshing the volume (Gmsh) for the FEM reference");
-    run.mesh = mesh_problem(problem);
+    // One mesh for every load, refined at each tool it presses with.
+    run.mesh = other_tools > 0 ? mesh_problem(problem, problem.tools) : mesh_problem(problem);
     progress.stage("solving the FEM reference (P" + std::to_string(parameters.fem.degree) + ", " +
                    std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
     run.fem = solve_fem(problem, run.mesh, tool);
@@ -165,18 +208,27 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
                        static_cast<int>(depths.size()), seconds_since(curve_start));
     }
+    const auto others_start = Clock::now();
+    for (int t = 1; t <= other_tools; ++t) {
+      other_fem.push_back(solve_fem(problem, run.mesh, problem.tools[t]));
+      progress.advance("FEM at the other tool positions", t, other_tools,
+                       seconds_since(others_start));
+    }
     if (settings.fem_cache_directory)
       store_fem_cache(*settings.fem_cache_directory, run.fem_cache_key,
-                      {run.mesh, run.fem, run.fem_force_depth});
+                      {run.mesh, run.fem, run.fem_force_depth, other_fem});
+  }
+  for (int t = 1; t <= other_tools; ++t) {
+    ToolLoad load;
+    load.tool = t;
+    load.fem = std::move(other_fem[t - 1]);
+    load.compared_vertices = unprescribed_vertices(problem, problem.tools[t]);
+    run.other_tools.push_back(std::move(load));
   }
 
   run.fem_force_depth_monotone = force_grows_with_depth(run.fem_force_depth, tool);
 
-  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
-  for (std::size_t v = 0; v < prescribed.size(); ++v)
-    if (!prescribed[v]) run.compared_vertices.push_back(static_cast<int>(v));
-  if (run.compared_vertices.empty())
-    throw cases::InputError(parameters.file.string() + ": every surface vertex is prescribed");
+  run.compared_vertices = unprescribed_vertices(problem, tool);
 
   const auto variants_start = Clock::now();
   const int total = static_cast<int>(parameters.mass_spring.variants.size());
@@ -190,32 +242,11 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       r.springs = built.model->network().num_springs();
       r.warnings = built.warnings;
       r.parameters = variant_parameters(*built.model);
-      StaticSolution s;
-      if (depths.empty()) {
-        s = solve_variant_static(built);
-        r.inverted_elements = inverted_tetrahedra(built, s.x);
-      } else {
-        // A quasi-static loading path, each depth started from the last, as a tool pressed in steps
-        // is: a network with several equilibria (one that buckles under the tool) then stays on the
-        // branch a simulator would follow, and the curve is the force a haptic device would render.
-        const std::vector<double> path =
-            loading_path(depths, tool->depth, parameters.loads.tool.path_step_m);
-        Eigen::VectorXd x;
-        for (double depth : path) {
-          set_tool_depth(built, at_depth(*tool, depth));
-          StaticSolution at = solve_variant_static(built, x);
-          x = at.x;
-          const std::optional<int> inverted = inverted_tetrahedra(built, at.x);
-          // Every step of the path is a point of the variant's curve: a fall between two curve
-          // depths must not go unseen.
-          r.force_depth.push_back({depth, at.tool_force, inverted});
-          if (depth == tool->depth) {
-            s = std::move(at);
-            r.inverted_elements = inverted;
-          }
-        }
-        set_tool_depth(built, *tool);
-      }
+      const std::vector<double> path =
+          depths.empty() ? std::vector<double>{}
+                         : loading_path(depths, tool->depth, parameters.loads.tool.path_step_m);
+      StaticSolution s = press(built, tool, path, r.force_depth);
+      r.inverted_elements = inverted_tetrahedra(built, s.x);
       r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
       if (r.force_depth_monotone == false)
         r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
@@ -232,6 +263,23 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
         r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
       r.volume_change = volume_change(problem.surface, s.surface_displacement);
       if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
+      for (ToolLoad& load : run.other_tools) {
+        const ToolPlacement& other = problem.tools[load.tool];
+        ToolLoadVariant o;
+        o.name = name;
+        std::vector<ForceDepthPoint> curve;
+        const StaticSolution at = press(built, other, path, curve);
+        o.force_depth_monotone = force_grows_with_depth(curve, other);
+        o.inverted_elements = inverted_tetrahedra(built, at.x);
+        o.errors = zoned_displacement_error(at.surface_displacement, load.fem.surface_displacement,
+                                            problem.surface.vertices, load.compared_vertices,
+                                            other.contact_point, 2 * other.radius);
+        o.tool_force = at.tool_force;
+        o.reaction_force_rel_error = reaction_force_rel_error(at.tool_force, load.fem.tool_force);
+        o.volume_change = volume_change(problem.surface, at.surface_displacement);
+        load.variants.push_back(std::move(o));
+      }
+      if (tool) set_tool_depth(built, *tool);
       run.variants.push_back(std::move(r));
     } catch (const cases::InputError&) {
       throw;

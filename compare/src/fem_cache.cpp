@@ -36,7 +36,8 @@ Eigen::Vector3d vec_from(const nlohmann::json& j) {
 
 }  // namespace
 
-std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths) {
+std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths,
+                          bool other_tools) {
   const auto& p = problem.parameters;
   ContentHash h;
   h.text(cache_version);
@@ -71,6 +72,8 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
   h.number(p.fem.tool_cell_size_m);
   for (double d : curve_depths)
     h.number(d);
+  // Keys of entries without them stay what they were, so existing entries remain valid.
+  if (other_tools) h.text("other tools");
   return h.hex();
 }
 
@@ -106,6 +109,17 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     s.statistics.solve_time_s = st.at("solve_time_s");
     for (const auto& p : j.at("force_depth"))
       e.force_depth.push_back({p.at("depth_m"), vec_from(p.at("force_N"))});
+    if (j.contains("other_tools"))
+      for (const auto& o : j.at("other_tools")) {
+        FemSolution t;
+        t.surface_displacement = matrix_from(o.at("surface_displacement"));
+        t.tool_force = vec_from(o.at("tool_force"));
+        t.solver = o.at("solver");
+        t.volume_change = o.at("volume_change");
+        t.statistics.iterations = o.at("iterations");
+        t.statistics.solve_time_s = o.at("solve_time_s");
+        e.other_tools.push_back(std::move(t));
+      }
     return e;
   } catch (const std::exception&) {
     return std::nullopt;
@@ -119,28 +133,38 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
   nlohmann::json fd = nlohmann::json::array();
   for (const auto& p : e.force_depth)
     fd.push_back({{"depth_m", p.depth_m}, {"force_N", vec(p.force_n)}});
-  const nlohmann::json j = {{"version", cache_version},
-                            {"key", key},
-                            {"mesh_vertices", matrix_json(e.mesh.vertices)},
-                            {"mesh_tetrahedra", matrix_json(e.mesh.tetrahedra.cast<double>())},
-                            {"num_surface_vertices", e.mesh.num_surface_vertices},
-                            {"vertex_displacement", matrix_json(s.vertex_displacement)},
-                            {"case_surface_vertices", s.surface_displacement.rows()},
-                            {"tool_force", vec(s.tool_force)},
-                            {"solver", s.solver},
-                            {"volume_change", s.volume_change},
-                            {"statistics",
-                             {{"dofs", st.dofs},
-                              {"cells", st.cells},
-                              {"vertices", st.vertices},
-                              {"prescribed_dofs", st.prescribed_dofs},
-                              {"mpi_ranks", st.mpi_ranks},
-                              {"iterations", st.iterations},
-                              {"residual_norm", st.residual_norm},
-                              {"setup_time_s", st.setup_time_s},
-                              {"assemble_time_s", st.assemble_time_s},
-                              {"solve_time_s", st.solve_time_s}}},
-                            {"force_depth", fd}};
+  nlohmann::json j = {{"version", cache_version},
+                      {"key", key},
+                      {"mesh_vertices", matrix_json(e.mesh.vertices)},
+                      {"mesh_tetrahedra", matrix_json(e.mesh.tetrahedra.cast<double>())},
+                      {"num_surface_vertices", e.mesh.num_surface_vertices},
+                      {"vertex_displacement", matrix_json(s.vertex_displacement)},
+                      {"case_surface_vertices", s.surface_displacement.rows()},
+                      {"tool_force", vec(s.tool_force)},
+                      {"solver", s.solver},
+                      {"volume_change", s.volume_change},
+                      {"statistics",
+                       {{"dofs", st.dofs},
+                        {"cells", st.cells},
+                        {"vertices", st.vertices},
+                        {"prescribed_dofs", st.prescribed_dofs},
+                        {"mpi_ranks", st.mpi_ranks},
+                        {"iterations", st.iterations},
+                        {"residual_norm", st.residual_norm},
+                        {"setup_time_s", st.setup_time_s},
+                        {"assemble_time_s", st.assemble_time_s},
+                        {"solve_time_s", st.solve_time_s}}},
+                      {"force_depth", fd}};
+  if (!e.other_tools.empty()) {
+    j["other_tools"] = nlohmann::json::array();
+    for (const auto& t : e.other_tools)
+      j["other_tools"].push_back({{"surface_displacement", matrix_json(t.surface_displacement)},
+                                  {"tool_force", vec(t.tool_force)},
+                                  {"solver", t.solver},
+                                  {"volume_change", t.volume_change},
+                                  {"iterations", t.statistics.iterations},
+                                  {"solve_time_s", t.statistics.solve_time_s}});
+  }
   std::filesystem::create_directories(directory);
   const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(j);
   write_file_atomically(directory / (key + ".cbor"), [&](const std::filesystem::path& tmp) {

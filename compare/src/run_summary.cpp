@@ -27,6 +27,44 @@ nlohmann::json zone(const ErrorMetrics& m) {
       {"rel_l2_error", m.rel_l2_error}, {"max_error_m", m.max_error_m}, {"vertices", m.vertices}};
 }
 
+nlohmann::json load_json(int tool, const ZonedErrorMetrics& e, const Eigen::Vector3d& force,
+                         double force_error, double volume_change,
+                         const std::optional<int>& inverted, const std::optional<bool>& monotone) {
+  return {{"tool", tool},
+          {"rel_l2_error", e.all.rel_l2_error},
+          {"rms_error_m", e.all.rms_error_m},
+          {"max_error_m", e.all.max_error_m},
+          {"mean_error_over_max_disp", e.all.mean_error_over_max_disp},
+          {"contact_zone", zone(e.contact_zone)},
+          {"far_field", zone(e.far_field)},
+          {"reaction_force_N", vec(force)},
+          {"reaction_force_rel_error", force_error},
+          {"volume_change", volume_change},
+          {"inverted_elements", optional_json(inverted)},
+          {"force_depth_monotone", optional_json(monotone)}};
+}
+
+// Every tool position of the case as its own load (the first is the variant's own row), with the
+// means a user comparing variants over the case wants.
+nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
+  nlohmann::json list = nlohmann::json::array();
+  list.push_back(load_json(0, v.errors, v.tool_force, v.reaction_force_rel_error, v.volume_change,
+                           v.inverted_elements, v.force_depth_monotone));
+  double l2 = v.errors.all.rel_l2_error, force = v.reaction_force_rel_error;
+  for (const auto& load : run.other_tools)
+    for (const auto& o : load.variants)
+      if (o.name == v.name) {
+        list.push_back(load_json(load.tool, o.errors, o.tool_force, o.reaction_force_rel_error,
+                                 o.volume_change, o.inverted_elements, o.force_depth_monotone));
+        l2 += o.errors.all.rel_l2_error;
+        force += o.reaction_force_rel_error;
+      }
+  const double n = static_cast<double>(list.size());
+  return {{"per_tool", list},
+          {"mean_rel_l2_error", l2 / n},
+          {"mean_reaction_force_rel_error", force / n}};
+}
+
 std::string command_output(const std::string& command) {
   std::array<char, 256> buffer{};
   std::string out;
@@ -84,6 +122,20 @@ nlohmann::json summary_json(const CaseRun& run) {
   fem["force_depth"] = curve;
   fem["force_depth_monotone"] = optional_json(run.fem_force_depth_monotone);
 
+  if (!run.other_tools.empty()) {
+    nlohmann::json loads = nlohmann::json::array();
+    loads.push_back({{"tool", 0},
+                     {"reaction_force_N", vec(run.fem.tool_force)},
+                     {"iterations", st.iterations},
+                     {"solve_time_s", st.solve_time_s}});
+    for (const auto& load : run.other_tools)
+      loads.push_back({{"tool", load.tool},
+                       {"reaction_force_N", vec(load.fem.tool_force)},
+                       {"iterations", load.fem.statistics.iterations},
+                       {"solve_time_s", load.fem.statistics.solve_time_s}});
+    fem["loads"] = loads;
+  }
+
   nlohmann::json variants = nlohmann::json::array();
   for (const auto& v : run.variants) {
     nlohmann::json fd = nlohmann::json::array();
@@ -120,6 +172,7 @@ nlohmann::json summary_json(const CaseRun& run) {
                         {"inverted_elements", optional_json(v.inverted_elements)},
                         {"warnings", v.warnings},
                         {"parameters", v.parameters}});
+    if (!run.other_tools.empty()) variants.back()["loads"] = variant_loads(run, v);
   }
   nlohmann::json failed = nlohmann::json::array();
   for (const auto& [name, why] : run.failed_variants)

@@ -53,6 +53,7 @@ std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
     run_settings.quiet = true;
     run_settings.force_depth_curve = false;
     run_settings.time_dynamics = false;
+    run_settings.all_tools = false;  // accuracy against speed at the case's first tool
     run_settings.fem_cache_directory = fem_cache_directory;
     const CaseRun run = run_case(p, run_settings);
     const std::optional<ToolPlacement> tool =

@@ -54,6 +54,27 @@ struct VariantResult {
   std::optional<int> inverted_elements;      ///< at the case's load; none for surface networks
 };
 
+/// One variant at one more of the case's tool positions (the second and later
+/// `loads/tool/directions`), at the case's depth, reached along the same loading path.
+struct ToolLoadVariant {
+  std::string name;
+  ZonedErrorMetrics errors;
+  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
+  double reaction_force_rel_error = 0.0;
+  double volume_change = 0.0;
+  std::optional<int> inverted_elements;
+  std::optional<bool> force_depth_monotone;  ///< along its loading path
+};
+
+/// The FEM and every variant pressed at problem.tools[tool], tool >= 1 (tool 0 is the run's own
+/// load: CaseRun::fem and CaseRun::variants).
+struct ToolLoad {
+  int tool = 0;
+  FemSolution fem;  ///< surface displacement, force and statistics
+  std::vector<int> compared_vertices;
+  std::vector<ToolLoadVariant> variants;
+};
+
 struct CaseRun {
   Problem problem;
   fem_reference::VolumeMesh mesh;
@@ -65,6 +86,7 @@ struct CaseRun {
   /// others are still compared; bad input stops the whole run.
   std::vector<std::pair<std::string, std::string>> failed_variants;
   std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
+  std::vector<ToolLoad> other_tools;   ///< the case's second and later tool positions
   double wall_time_s = 0.0;
   std::string fem_cache_key;
   bool fem_from_cache = false;
@@ -74,6 +96,8 @@ struct RunSettings {
   bool quiet = false;
   bool force_depth_curve = true;
   bool time_dynamics = true;
+  /// Press at every tool position of the case, each its own load (false: the first only).
+  bool all_tools = true;
   /// Where FEM results are cached (none: always solve).
   std::optional<std::filesystem::path> fem_cache_directory;
 };

@@ -18,10 +18,14 @@ struct FemCacheEntry {
   fem_reference::VolumeMesh mesh;
   FemSolution solution;
   std::vector<ForceDepthPoint> force_depth;
+  /// The problem's second and later tools at full depth (surface displacement, force, statistics).
+  std::vector<FemSolution> other_tools;
 };
 
-/// 16 hex digits of a 64-bit FNV-1a hash of the problem's FEM inputs and the curve depths.
-std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths);
+/// 16 hex digits of a 64-bit FNV-1a hash of the problem's FEM inputs and the curve depths, and
+/// whether the entry holds the other tools' solutions too.
+std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths,
+                          bool other_tools = false);
 
 /// The entry for `key` under `directory`, or none (missing or unreadable: a stale or damaged
 /// entry is recomputed, never trusted).
