@@ -11,7 +11,8 @@ packages=(
   libhdf5-openmpi-dev    # fields.h5 output (the HDF5 deal.II links, so one HDF5 per process)
   nlohmann-json3-dev     # summary.json and every --json output
   libnlopt-cxx-dev       # msfem calibrate: derivative-free optimiser (BOBYQA) for spring coefficients
-  libsuitesparse-dev     # msfem calibrate: CHOLMOD for the linearised spring models
+  libsuitesparse-dev     # CHOLMOD: spring statics in msfem run/sweep/calibrate
+  libopenblas0-serial    # optimised BLAS under CHOLMOD's supernodal kernels (reference BLAS is 2x slower)
   libgtest-dev           # unit and end-to-end tests
   libbenchmark-dev       # speed measurements
   gnuplot-nox            # plots in report.md

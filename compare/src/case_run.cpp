@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <thread>
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/fem_cache.hpp"
@@ -105,6 +107,53 @@ StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& to
   }
   set_tool_depth(built, *tool);
   return s;
+}
+
+// The variant at each of the case's other tool positions, along the same loading path. Two
+// workers (each with its own copy of the network) share the tools: the statics are independent
+// and a machine with two cores finishes the brain's four tools in about half the time. The
+// timing is over by now, so nothing measured runs beside them.
+void press_other_tools(CaseRun& run, BuiltVariant& built, const std::vector<double>& path) {
+  const int n = static_cast<int>(run.other_tools.size());
+  if (n == 0) return;
+  const Problem& problem = run.problem;
+  std::vector<ToolLoadVariant> results(n);
+  std::vector<std::exception_ptr> errors(n);
+  auto work = [&](BuiltVariant& variant, int first) {
+    for (int k = first; k < n; k += 2) {
+      try {
+        const ToolLoad& load = run.other_tools[k];
+        const ToolPlacement& other = problem.tools[load.tool];
+        ToolLoadVariant& o = results[k];
+        o.name = variant.name;
+        std::vector<ForceDepthPoint> curve;
+        const StaticSolution at = press(variant, other, path, curve);
+        o.force_depth_monotone = force_grows_with_depth(curve, other);
+        o.inverted_elements = inverted_tetrahedra(variant, at.x);
+        o.errors = zoned_displacement_error(at.surface_displacement, load.fem.surface_displacement,
+                                            problem.surface.vertices, load.compared_vertices,
+                                            other.contact_point, 2 * other.radius);
+        o.tool_force = at.tool_force;
+        o.reaction_force_rel_error = reaction_force_rel_error(at.tool_force, load.fem.tool_force);
+        o.volume_change = volume_change(problem.surface, at.surface_displacement);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  };
+  if (n == 1 || std::thread::hardware_concurrency() < 2) {
+    work(built, 0);
+  } else {
+    const std::optional<ToolPlacement> first_tool = problem.tools.front();
+    BuiltVariant copy = build_variant(built.name, problem, run.mesh, first_tool);
+    std::thread second([&] { work(copy, 1); });
+    work(built, 0);
+    second.join();
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  for (int k = 0; k < n; ++k)
+    run.other_tools[k].variants.push_back(std::move(results[k]));
 }
 
 }  // namespace
@@ -263,22 +312,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
         r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
       r.volume_change = volume_change(problem.surface, s.surface_displacement);
       if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
-      for (ToolLoad& load : run.other_tools) {
-        const ToolPlacement& other = problem.tools[load.tool];
-        ToolLoadVariant o;
-        o.name = name;
-        std::vector<ForceDepthPoint> curve;
-        const StaticSolution at = press(built, other, path, curve);
-        o.force_depth_monotone = force_grows_with_depth(curve, other);
-        o.inverted_elements = inverted_tetrahedra(built, at.x);
-        o.errors = zoned_displacement_error(at.surface_displacement, load.fem.surface_displacement,
-                                            problem.surface.vertices, load.compared_vertices,
-                                            other.contact_point, 2 * other.radius);
-        o.tool_force = at.tool_force;
-        o.reaction_force_rel_error = reaction_force_rel_error(at.tool_force, load.fem.tool_force);
-        o.volume_change = volume_change(problem.surface, at.surface_displacement);
-        load.variants.push_back(std::move(o));
-      }
+      press_other_tools(run, built, path);
       if (tool) set_tool_depth(built, *tool);
       run.variants.push_back(std::move(r));
     } catch (const cases::InputError&) {

@@ -79,14 +79,21 @@ bool TangentFactor::factorize(const Eigen::SparseMatrix<double>& k) {
   if (!analysed_ || !same_pattern(k)) {
     // The ordering costs as much as a tenth of a factorisation on the brain; the pattern never
     // changes within a solve.
-    ldlt_.analyzePattern(k);
+    if (plugged_)
+      plugged_->analyze(k);
+    else
+      ldlt_.analyzePattern(k);
     outer_.assign(k.outerIndexPtr(), k.outerIndexPtr() + k.outerSize() + 1);
     inner_.assign(k.innerIndexPtr(), k.innerIndexPtr() + k.nonZeros());
     analysed_ = true;
   }
-  ldlt_.factorize(k);
   ++factorizations_;
   valid_ = false;
+  if (plugged_) {
+    valid_ = plugged_->factorize(k);
+    return valid_;
+  }
+  ldlt_.factorize(k);
   if (ldlt_.info() != Eigen::Success) return false;
   const Eigen::VectorXd pivots = ldlt_.vectorD();
   valid_ = pivots.allFinite() && (pivots.array() > 1e-12 * pivots.cwiseAbs().maxCoeff()).all();

@@ -8,9 +8,11 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/static_solver.hpp"
 
 namespace msfem::massspring::detail {
 
@@ -50,15 +52,21 @@ class TangentOperator {
 /// as long as the matrix pattern stays the same.
 class TangentFactor {
  public:
+  /// `plugged` replaces the SimplicialLDLT when given (StaticOptions::factorization).
+  explicit TangentFactor(std::unique_ptr<SparseSpdFactor> plugged = nullptr)
+      : plugged_(std::move(plugged)) {}
   /// Factorises k; false (and no usable factor) if k is not numerically positive definite.
   bool factorize(const Eigen::SparseMatrix<double>& k);
   bool valid() const { return valid_; }
-  Eigen::VectorXd solve(const Eigen::VectorXd& r) const { return ldlt_.solve(r); }
+  Eigen::VectorXd solve(const Eigen::VectorXd& r) const {
+    return plugged_ ? plugged_->solve(r) : Eigen::VectorXd(ldlt_.solve(r));
+  }
   int factorizations() const { return factorizations_; }
 
  private:
   bool same_pattern(const Eigen::SparseMatrix<double>& k) const;
 
+  std::unique_ptr<SparseSpdFactor> plugged_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
   std::vector<int> outer_, inner_;  // pattern the analysis was made for
   bool analysed_ = false;

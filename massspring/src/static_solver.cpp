@@ -55,7 +55,8 @@ class DirectionFinder {
       : model_(model),
         dofs_(dofs),
         options_(options),
-        free_mass_(dofs.gather(model.mass_per_dof())) {}
+        free_mass_(dofs.gather(model.mass_per_dof())),
+        factor_(options.factorization ? options.factorization() : nullptr) {}
 
   // d with d·r > 0 (a descent direction for the energy); false if every linearisation is singular.
   bool find(const Eigen::VectorXd& x, const Eigen::VectorXd& r, double linear_tolerance,

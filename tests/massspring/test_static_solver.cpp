@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseCholesky>
 #include <cmath>
+#include <memory>
 
 #include "icosphere.hpp"
 #include "msfem/massspring/static_solver.hpp"
@@ -72,6 +74,40 @@ void expect_same_equilibrium_fewer_factorizations(const MassSpringModel& model) 
   EXPECT_LT(fast.factorizations, plain.factorizations);
   EXPECT_GT(fast.preconditioned_iterations, 0);
   EXPECT_EQ(fast.history.size(), static_cast<std::size_t>(fast.iterations));
+}
+
+// A plugged factorisation (here Eigen's SimplicialLLT, counting its calls) stands in for the
+// built-in LDLT everywhere: indefinite tangents included, which it must refuse.
+class CountingLlt final : public SparseSpdFactor {
+ public:
+  explicit CountingLlt(int& calls) : calls_(calls) {}
+  void analyze(const Eigen::SparseMatrix<double>& k) override { llt_.analyzePattern(k); }
+  bool factorize(const Eigen::SparseMatrix<double>& k) override {
+    ++calls_;
+    llt_.factorize(k);
+    return llt_.info() == Eigen::Success;
+  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& r) const override { return llt_.solve(r); }
+
+ private:
+  int& calls_;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;
+};
+
+TEST(StaticSolverPluggedFactorization, GivesTheBuiltInEquilibriumAndIsTheOneUsed) {
+  for (const MassSpringModel& model : {indented_sphere(), indented_banana()}) {
+    const StaticResult builtin = solve_static(model);
+    int calls = 0;
+    StaticOptions options;
+    options.factorization = [&calls] { return std::make_unique<CountingLlt>(calls); };
+    const StaticResult plugged = solve_static(model, options);
+    ASSERT_TRUE(builtin.converged);
+    ASSERT_TRUE(plugged.converged);
+    EXPECT_EQ(calls, plugged.factorizations);
+    EXPECT_GT(calls, 0);
+    const double displacement = (builtin.x - model.initial_state()).norm();
+    EXPECT_LE((plugged.x - builtin.x).norm(), 1e-9 * displacement);
+  }
 }
 
 TEST(StaticSolverAcceleration, SphereMatchesPlainNewton) {

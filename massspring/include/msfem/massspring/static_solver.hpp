@@ -1,6 +1,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include "msfem/massspring/mass_spring_model.hpp"
@@ -12,7 +15,24 @@ enum class StaticLinearSolver {
   cg            ///< Jacobi-preconditioned conjugate gradients (definite linearisation)
 };
 
+/// A sparse symmetric positive definite factorisation the static solver can use in place of
+/// Eigen's SimplicialLDLT: a simulator plugs in the direct solver it already links (CHOLMOD,
+/// PARDISO, ...) without this library depending on it. `msfem` plugs in CHOLMOD's supernodal
+/// Cholesky, many times faster on the three-dimensional tet_edges networks.
+class SparseSpdFactor {
+ public:
+  virtual ~SparseSpdFactor() = default;
+  /// Symbolic analysis (ordering) for k's pattern; called again only when the pattern changes.
+  virtual void analyze(const Eigen::SparseMatrix<double>& k) = 0;
+  /// Numeric factorisation of k (full symmetric storage); false if k is not numerically
+  /// positive definite.
+  virtual bool factorize(const Eigen::SparseMatrix<double>& k) = 0;
+  virtual Eigen::VectorXd solve(const Eigen::VectorXd& r) const = 0;
+};
+
 struct StaticOptions {
+  /// Makes the factorisation sparse_ldlt uses; empty: Eigen's SimplicialLDLT (AMD ordering).
+  std::function<std::unique_ptr<SparseSpdFactor>()> factorization;
   StaticLinearSolver linear_solver = StaticLinearSolver::sparse_ldlt;
   int max_iterations = 100;
   /// Converged when |f_free| <= tolerance × max(|applied loads|, |f_free at the initial state|),
