@@ -7,6 +7,10 @@ namespace {
 
 class CholmodFactor final : public massspring::SparseSpdFactor {
  public:
+  // An indefinite tangent is an expected outcome the solver handles (it falls back to the definite
+  // linearisation), not something CHOLMOD should print: by default it writes a warning to stdout,
+  // which would corrupt `--json` output.
+  CholmodFactor() { llt_.cholmod().print = 0; }
   void analyze(const Eigen::SparseMatrix<double>& k) override { llt_.analyzePattern(k); }
   bool factorize(const Eigen::SparseMatrix<double>& k) override {
     llt_.factorize(k);
