@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -49,6 +50,18 @@ double cpu_seconds() {
   timespec t{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// PETSC_OPTIONS as given (quotes and backslashes escaped for JSON): a run records its solver
+// options.
+std::string petsc_options() {
+  const char* value = std::getenv("PETSC_OPTIONS");
+  std::string out;
+  for (const char* c = value ? value : ""; *c; ++c) {
+    if (*c == '"' || *c == '\\') out += '\\';
+    out += *c;
+  }
+  return out;
 }
 
 double peak_rss_mb() {
@@ -175,13 +188,13 @@ int main(int argc, char** argv) {
           "\"total_s\": %.3f, \"tool_force_z_n\": %.6g, \"equilibrium_defect\": %.3g, "
           "\"peak_rss_mb_rank0_after_mesh\": %.0f, \"peak_rss_mb_largest_rank\": %.0f, "
           "\"peak_rss_mb_all_ranks\": %.0f, \"load_average_before\": \"%s\", "
-          "\"load_average_after\": \"%s\"}\n",
+          "\"load_average_after\": \"%s\", \"petsc_options\": \"%s\"}\n",
           settings.shape.c_str(), settings.degree, settings.cell_size, settings.algorithm, ranks,
           st.dofs, st.cells, st.vertices, st.iterations, mesh_s, st.setup_time_s,
           st.assemble_time_s, st.solve_time_s, problem_s, problem_cpu_s,
           mesh_s + st.assemble_time_s + st.solve_time_s, total_s, force.z(),
           problem.equilibrium_defect(), rss_after_mesh, rss_max, rss_sum, load_before.c_str(),
-          load_average().c_str());
+          load_average().c_str(), petsc_options().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fem_reference_bench (rank %d): error: %s\n", rank, e.what());
     status = 2;

@@ -25,6 +25,50 @@ void check(PetscErrorCode code, const char* call) {
 }
 #define MSFEM_PETSC(call) check((call), #call)
 
+/// Point-block Jacobi (the nodes' 3x3 blocks) instead of point Jacobi in the finest level's
+/// Chebyshev smoother of GAMG. Only there: a coarse level's aggregate of one node (presumably a
+/// prescribed node, isolated in the graph) has six coarse unknowns of which three have zero rows
+/// (three rigid-body modes on one node span only three directions), so its 6x6 blocks are singular
+/// and point-block Jacobi (or SOR) fails there, while point Jacobi replaces zero diagonals. The
+/// finest level's index is known only once GAMG has built the hierarchy, hence after KSPSetUp, with
+/// the smoother's eigenvalue bounds estimated again for the new preconditioner (GAMG's own estimate
+/// is for point Jacobi). Skipped where the user's options chose a smoother (-mg_levels[_N]_pc_type,
+/// -mg_levels[_N]_ksp_type; `-mg_levels_pc_type jacobi` gives PETSc's default) or where the set-up
+/// failed (KSPSolve then reports the failure).
+void finest_smoother_point_block_jacobi(KSP ksp, PC pc) {
+  PetscBool user_choice = PETSC_FALSE, flag = PETSC_FALSE;
+  for (const char* name : {"-mg_levels_pc_type", "-mg_levels_ksp_type"}) {
+    PetscOptionsHasName(nullptr, nullptr, name, &flag);
+    user_choice = PetscBool(user_choice || flag);
+  }
+  PetscBool gamg = PETSC_FALSE;  // not where the options chose another -pc_type
+  MSFEM_PETSC(PetscObjectTypeCompare(PetscObject(pc), PCGAMG, &gamg));
+  if (user_choice || !gamg) return;
+  if (KSPSetUp(ksp) != 0) return;
+  PetscInt levels = 0;
+  MSFEM_PETSC(PCMGGetLevels(pc, &levels));
+  if (levels < 2) return;
+  for (const char* option : {"pc_type", "ksp_type"}) {
+    const std::string name = "-mg_levels_" + std::to_string(levels - 1) + "_" + std::string(option);
+    PetscOptionsHasName(nullptr, nullptr, name.c_str(), &flag);
+    if (flag) return;
+  }
+  KSP smoother = nullptr;
+  MSFEM_PETSC(PCMGGetSmoother(pc, levels - 1, &smoother));
+  PC smoother_pc = nullptr;
+  MSFEM_PETSC(KSPGetPC(smoother, &smoother_pc));
+  PetscBool chebyshev = PETSC_FALSE, jacobi = PETSC_FALSE;
+  MSFEM_PETSC(PetscObjectTypeCompare(PetscObject(smoother), KSPCHEBYSHEV, &chebyshev));
+  MSFEM_PETSC(PetscObjectTypeCompare(PetscObject(smoother_pc), PCJACOBI, &jacobi));
+  if (!chebyshev || !jacobi) return;
+  Mat a = nullptr, p = nullptr;
+  MSFEM_PETSC(KSPGetOperators(smoother, &a, &p));
+  MSFEM_PETSC(PCSetType(smoother_pc, PCPBJACOBI));
+  MSFEM_PETSC(KSPSetOperators(smoother, a, p));  // set-up again: new PC, new eigenvalue estimate
+  MSFEM_PETSC(KSPChebyshevEstEigSet(smoother, 0.0, 0.1, 0.0, 1.1));  // PETSc's default targets
+  KSPSetUp(smoother);  // a failure here shows in KSPSolve's converged reason (GAMG's fallback)
+}
+
 bool mpi_initialized_here = false;
 
 /// Called by MPI_Finalize (it frees MPI_COMM_SELF's attributes first, while MPI still works), so
@@ -218,6 +262,7 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
     MSFEM_PETSC(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
   }
   MSFEM_PETSC(KSPSetFromOptions(ksp));
+  if (settings.preconditioner == Preconditioner::gamg) finest_smoother_point_block_jacobi(ksp, pc);
   const PetscErrorCode solve_code = KSPSolve(ksp, rhs_, solution_);
   KSPConvergedReason reason;
   KSPGetConvergedReason(ksp, &reason);
