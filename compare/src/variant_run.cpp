@@ -194,7 +194,14 @@ StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::Ve
   if (model.num_nodes() > 500000) options.linear_solver = ms::StaticLinearSolver::cg;
   // Supernodal: on the brain's tet_edges network SimplicialLDLT took ~90 % of the statics.
   options.factorization = cholmod_factorization();
-  const ms::StaticResult r = ms::solve_static(model, options, start);
+  ms::StaticResult r;
+  try {
+    r = ms::solve_static(model, options, start);
+  } catch (const ms::ModelError& e) {
+    // A singular tangent at some Newton iterate is this load's solver failing (the supports were
+    // checked when the variant was built): the variant fails, the run goes on.
+    throw std::runtime_error("variant " + variant.name + ": " + e.what());
+  }
   StaticSolution solution;
   solution.solve_time_s = seconds_since(clock_start);
   if (!r.converged)
