@@ -126,9 +126,8 @@ void press_other_tools(CaseRun& run, BuiltVariant& built, const std::vector<doub
         const ToolPlacement& other = problem.tools[load.tool];
         ToolLoadVariant& o = results[k];
         o.name = variant.name;
-        std::vector<ForceDepthPoint> curve;
-        const StaticSolution at = press(variant, other, path, curve);
-        o.force_depth_monotone = force_grows_with_depth(curve, other);
+        const StaticSolution at = press(variant, other, path, o.force_depth);
+        o.force_depth_monotone = force_grows_with_depth(o.force_depth, other);
         o.inverted_elements = inverted_tetrahedra(variant, at.x);
         o.errors = zoned_displacement_error(at.surface_displacement, load.fem.surface_displacement,
                                             problem.surface.vertices, load.compared_vertices,
@@ -313,6 +312,11 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       r.volume_change = volume_change(problem.surface, s.surface_displacement);
       if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
       press_other_tools(run, built, path);
+      for (const ToolLoad& load : run.other_tools)
+        if (load.variants.back().force_depth_monotone == false)
+          r.warnings.push_back(
+              "tool " + std::to_string(load.tool) + ": " +
+              force_falls_warning(load.variants.back().force_depth, built.tetrahedra.rows()));
       if (tool) set_tool_depth(built, *tool);
       run.variants.push_back(std::move(r));
     } catch (const cases::InputError&) {

@@ -112,13 +112,14 @@ std::string tool_positions_table(const CaseRun& run) {
   for (const auto& v : run.variants) {
     double l2 = v.errors.all.rel_l2_error, force = v.reaction_force_rel_error;
     char cell[64];
-    std::snprintf(cell, sizeof cell, " %.3f / %.3f |", l2, force);
+    std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", l2, force,
+                  v.force_depth_monotone == false ? " †" : "");
     md << "| " << v.name << " |" << cell;
     for (const auto& load : run.other_tools)
       for (const auto& o : load.variants)
         if (o.name == v.name) {
-          std::snprintf(cell, sizeof cell, " %.3f / %.3f |", o.errors.all.rel_l2_error,
-                        o.reaction_force_rel_error);
+          std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
+                        o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
           md << cell;
           l2 += o.errors.all.rel_l2_error;
           force += o.reaction_force_rel_error;
@@ -127,7 +128,8 @@ std::string tool_positions_table(const CaseRun& run) {
     md << cell << "\n";
   }
   md << "\nTool 0 is the load of the tables above; each other tool presses alone to the same depth "
-        "along the same loading path, on the same FEM mesh (refined at every tool).\n";
+        "along the same loading path, on the same FEM mesh (refined at every tool). † the force "
+        "does not grow with depth along that tool's path (see the warnings).\n";
   return md.str();
 }
 

@@ -27,6 +27,15 @@ nlohmann::json zone(const ErrorMetrics& m) {
       {"rel_l2_error", m.rel_l2_error}, {"max_error_m", m.max_error_m}, {"vertices", m.vertices}};
 }
 
+nlohmann::json curve_json(const std::vector<ForceDepthPoint>& curve) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& pt : curve)
+    points.push_back({{"depth_m", pt.depth_m},
+                      {"force_N", vec(pt.force_n)},
+                      {"inverted_elements", optional_json(pt.inverted_elements)}});
+  return points;
+}
+
 nlohmann::json load_json(int tool, const ZonedErrorMetrics& e, const Eigen::Vector3d& force,
                          double force_error, double volume_change,
                          const std::optional<int>& inverted, const std::optional<bool>& monotone) {
@@ -50,12 +59,14 @@ nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
   nlohmann::json list = nlohmann::json::array();
   list.push_back(load_json(0, v.errors, v.tool_force, v.reaction_force_rel_error, v.volume_change,
                            v.inverted_elements, v.force_depth_monotone));
+  list.back()["force_depth"] = curve_json(v.force_depth);
   double l2 = v.errors.all.rel_l2_error, force = v.reaction_force_rel_error;
   for (const auto& load : run.other_tools)
     for (const auto& o : load.variants)
       if (o.name == v.name) {
         list.push_back(load_json(load.tool, o.errors, o.tool_force, o.reaction_force_rel_error,
                                  o.volume_change, o.inverted_elements, o.force_depth_monotone));
+        list.back()["force_depth"] = curve_json(o.force_depth);
         l2 += o.errors.all.rel_l2_error;
         force += o.reaction_force_rel_error;
       }
@@ -138,11 +149,7 @@ nlohmann::json summary_json(const CaseRun& run) {
 
   nlohmann::json variants = nlohmann::json::array();
   for (const auto& v : run.variants) {
-    nlohmann::json fd = nlohmann::json::array();
-    for (const auto& pt : v.force_depth)
-      fd.push_back({{"depth_m", pt.depth_m},
-                    {"force_N", vec(pt.force_n)},
-                    {"inverted_elements", optional_json(pt.inverted_elements)}});
+    const nlohmann::json fd = curve_json(v.force_depth);
     variants.push_back({{"name", v.name},
                         {"nodes", v.nodes},
                         {"springs", v.springs},

@@ -267,6 +267,7 @@ TEST(CliRun, EveryToolPositionIsItsOwnLoadAndCentralSymmetryHoldsAcrossThem) {
     ASSERT_EQ(loads.size(), 3u) << v["name"];
     EXPECT_EQ(loads[0]["rel_l2_error"], v["rel_l2_error"]);
     EXPECT_EQ(loads[1]["tool"], 1);
+    EXPECT_EQ(loads[2]["force_depth"].size(), v["force_depth"].size());  // the same path
     expect_finite_numbers(v["loads"], v["name"]);
     const double mean =
         (loads[0]["rel_l2_error"].get<double>() + loads[1]["rel_l2_error"].get<double>() +

@@ -63,6 +63,7 @@ struct ToolLoadVariant {
   double reaction_force_rel_error = 0.0;
   double volume_change = 0.0;
   std::optional<int> inverted_elements;
+  std::vector<ForceDepthPoint> force_depth;  ///< every step of its loading path
   std::optional<bool> force_depth_monotone;  ///< along its loading path
 };
 
