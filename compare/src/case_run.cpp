@@ -299,6 +299,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       if (r.force_depth_monotone == false)
         r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
       r.newton_iterations = s.newton_iterations;
+      r.equilibrium = s.x;
       r.surface_displacement = s.surface_displacement;
       r.error = s.surface_displacement - run.fem.surface_displacement;
       const Eigen::Vector3d zone_center = tool ? tool->contact_point : problem.centroid;

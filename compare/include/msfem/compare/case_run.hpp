@@ -47,6 +47,7 @@ struct VariantResult {
   int newton_iterations = 0;
   nlohmann::json parameters;  ///< group stiffness, damping, masses as used
   std::vector<std::string> warnings;
+  Eigen::VectorXd equilibrium;            ///< every node's position at the case's load, m
   Eigen::MatrixX3d surface_displacement;  ///< at the surface vertices, m
   Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
   std::vector<ForceDepthPoint> force_depth;
