@@ -61,10 +61,13 @@ int sweep_command(const Arguments& args) {
                                               : std::filesystem::path(parameters.output.directory) /
                                                     (parameters.name + "-sweep-" + run_timestamp());
   std::ostringstream printed;
+  std::vector<std::pair<int, std::string>> failed;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work) {
-    const auto points = run_sweep(
+    const SweepResult result = run_sweep(
         parameters, settings, std::filesystem::path(parameters.output.directory) / ".fem-cache");
-    const nlohmann::json j = sweep_json(parameters, points);
+    const auto& points = result.points;
+    failed = result.failed_resolutions;
+    const nlohmann::json j = sweep_json(parameters, result);
     write_text_atomically(work / "sweep.json", j.dump(2) + "\n");
     std::string plot_line = "(plot skipped: gnuplot is not installed)";
     if (gnuplot_available()) {
@@ -78,7 +81,10 @@ int sweep_command(const Arguments& args) {
                  pareto_points);
       plot_line = "![Pareto plot](" + file.filename().string() + ")";
     }
-    const std::string table = sweep_table(points);
+    std::string table = sweep_table(points);
+    for (const auto& [resolution, why] : result.failed_resolutions)
+      table += "\n> **resolution " + std::to_string(resolution) +
+               " failed** and is left out of the table and plot: " + why + "\n";
     write_text_atomically(work / "report.md",
                           "# msfem sweep: " + parameters.name + "\n\n" + table +
                               "\nrel L2 against the FEM at each resolution; steps/s at half of "
@@ -89,7 +95,10 @@ int sweep_command(const Arguments& args) {
                                  : table + "results in " + final_dir.string() + "\n");
   });
   std::cout << printed.str();
-  return 0;
+  // The sweep's other resolutions are written; a script still learns that one is missing.
+  for (const auto& [resolution, why] : failed)
+    std::cerr << "msfem sweep: resolution " << resolution << " failed: " << why << "\n";
+  return failed.empty() ? 0 : 1;
 }
 
 }  // namespace msfem::compare

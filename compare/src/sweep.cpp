@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <sstream>
 
 #include "msfem/cases/surface_generators.hpp"
@@ -37,18 +38,14 @@ cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
   return p;
 }
 
-}  // namespace
-
-std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
-                                  const SweepSettings& settings,
-                                  const std::filesystem::path& fem_cache_directory) {
-  const std::vector<int> resolutions =
-      settings.resolutions.empty() ? default_resolutions(parameters) : settings.resolutions;
-  const Progress progress(settings.quiet);
-  const auto start = std::chrono::steady_clock::now();
+// One resolution's points, appended to `points` (nothing is appended if it fails).
+void sweep_resolution(const cases::CaseParameters& parameters, int resolution,
+                      const SweepSettings& settings,
+                      const std::filesystem::path& fem_cache_directory,
+                      std::vector<SweepPoint>& all_points) {
   std::vector<SweepPoint> points;
-  for (std::size_t r = 0; r < resolutions.size(); ++r) {
-    const cases::CaseParameters p = at_resolution(parameters, resolutions[r]);
+  {
+    const cases::CaseParameters p = at_resolution(parameters, resolution);
     RunSettings run_settings;
     run_settings.quiet = true;
     run_settings.force_depth_curve = false;
@@ -70,7 +67,7 @@ std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
         SweepPoint pt;
         pt.variant = v.name;
         pt.integrator = integrator;
-        pt.resolution = resolutions[r];
+        pt.resolution = resolution;
         pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
         pt.nodes = v.nodes;
         pt.springs = v.springs;
@@ -83,18 +80,42 @@ std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
         points.push_back(pt);
       }
     }
+  }
+  all_points.insert(all_points.end(), points.begin(), points.end());
+}
+
+}  // namespace
+
+SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
+                      const std::filesystem::path& fem_cache_directory) {
+  const std::vector<int> resolutions =
+      settings.resolutions.empty() ? default_resolutions(parameters) : settings.resolutions;
+  const Progress progress(settings.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  SweepResult result;
+  std::vector<SweepPoint>& points = result.points;
+  std::exception_ptr first_failure;
+  for (std::size_t r = 0; r < resolutions.size(); ++r) {
+    try {
+      sweep_resolution(parameters, resolutions[r], settings, fem_cache_directory, points);
+    } catch (const std::exception& e) {
+      if (!first_failure) first_failure = std::current_exception();
+      result.failed_resolutions.emplace_back(resolutions[r], e.what());
+      progress.stage("sweep resolution " + std::to_string(resolutions[r]) + " failed: " + e.what());
+    }
     progress.advance(
         "sweep resolution " + std::to_string(resolutions[r]), static_cast<int>(r + 1),
         static_cast<int>(resolutions.size()),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
-  return points;
+  // Nothing to show: the first failure as it was (bad input stays bad input).
+  if (points.empty() && first_failure) std::rethrow_exception(first_failure);
+  return result;
 }
 
-nlohmann::json sweep_json(const cases::CaseParameters& parameters,
-                          const std::vector<SweepPoint>& points) {
+nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result) {
   nlohmann::json list = nlohmann::json::array();
-  for (const auto& p : points)
+  for (const auto& p : result.points)
     list.push_back({{"variant", p.variant},
                     {"integrator", p.integrator},
                     {"resolution", p.resolution},
@@ -107,11 +128,15 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters,
                     {"steps_per_second", p.steps_per_second},
                     {"realtime_factor", p.realtime_factor},
                     {"ms_per_60hz_frame", p.ms_per_60hz_frame}});
+  nlohmann::json failed = nlohmann::json::array();
+  for (const auto& [resolution, why] : result.failed_resolutions)
+    failed.push_back({{"resolution", resolution}, {"error", why}});
   return {{"case", parameters.name},
           {"git_revision", git_revision()},
           {"machine", machine_description()},
           {"units", {{"length", "m"}, {"time", "s"}}},
-          {"points", list}};
+          {"points", list},
+          {"failed_resolutions", failed}};
 }
 
 std::string sweep_table(const std::vector<SweepPoint>& points) {

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "msfem/cases/case_parameters.hpp"
@@ -28,13 +29,19 @@ struct SweepPoint {
   double ms_per_60hz_frame = 0.0;
 };
 
-/// Runs the sweep (the FEM once per resolution, through the cache when given).
-std::vector<SweepPoint> run_sweep(const cases::CaseParameters& parameters,
-                                  const SweepSettings& settings,
-                                  const std::filesystem::path& fem_cache_directory);
+struct SweepResult {
+  std::vector<SweepPoint> points;
+  /// Resolutions that could not be run (e.g. the brain simplified below ~2,500 vertices
+  /// self-intersects in its sulci), with the reason; the others are still swept.
+  std::vector<std::pair<int, std::string>> failed_resolutions;
+};
 
-nlohmann::json sweep_json(const cases::CaseParameters& parameters,
-                          const std::vector<SweepPoint>& points);
+/// Runs the sweep (the FEM once per resolution, through the cache when given). Throws when no
+/// resolution can be run (the first one's error).
+SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
+                      const std::filesystem::path& fem_cache_directory);
+
+nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result);
 std::string sweep_table(const std::vector<SweepPoint>& points);
 
 }  // namespace msfem::compare
