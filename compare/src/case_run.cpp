@@ -109,6 +109,26 @@ StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& to
   return s;
 }
 
+// The variant's equilibrium `s` (reached along `curve`) against the FEM's at the same tool: the
+// same metrics for the run's own tool and for every other one.
+ToolLoadVariant compare_at_tool(const Problem& problem, const BuiltVariant& built,
+                                const StaticSolution& s, std::vector<ForceDepthPoint> curve,
+                                const FemSolution& fem, const std::vector<int>& compared,
+                                const std::optional<ToolPlacement>& tool) {
+  ToolLoadVariant o;
+  o.name = built.name;
+  o.errors = zoned_displacement_error(
+      s.surface_displacement, fem.surface_displacement, problem.surface.vertices, compared,
+      tool ? tool->contact_point : problem.centroid, tool ? 2 * tool->radius : 0.0);
+  o.tool_force = s.tool_force;
+  if (tool) o.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, fem.tool_force);
+  o.volume_change = volume_change(problem.surface, s.surface_displacement);
+  o.inverted_elements = inverted_tetrahedra(built, s.x);
+  o.force_depth_monotone = force_grows_with_depth(curve, tool);
+  o.force_depth = std::move(curve);
+  return o;
+}
+
 // The variant at each of the case's other tool positions, along the same loading path. Two
 // workers (each with its own copy of the network) share the tools: the statics are independent
 // and a machine with two cores finishes the brain's four tools in about half the time. The
@@ -124,17 +144,10 @@ void press_other_tools(CaseRun& run, BuiltVariant& built, const std::vector<doub
       try {
         const ToolLoad& load = run.other_tools[k];
         const ToolPlacement& other = problem.tools[load.tool];
-        ToolLoadVariant& o = results[k];
-        o.name = variant.name;
-        const StaticSolution at = press(variant, other, path, o.force_depth);
-        o.force_depth_monotone = force_grows_with_depth(o.force_depth, other);
-        o.inverted_elements = inverted_tetrahedra(variant, at.x);
-        o.errors = zoned_displacement_error(at.surface_displacement, load.fem.surface_displacement,
-                                            problem.surface.vertices, load.compared_vertices,
-                                            other.contact_point, 2 * other.radius);
-        o.tool_force = at.tool_force;
-        o.reaction_force_rel_error = reaction_force_rel_error(at.tool_force, load.fem.tool_force);
-        o.volume_change = volume_change(problem.surface, at.surface_displacement);
+        std::vector<ForceDepthPoint> curve;
+        const StaticSolution at = press(variant, other, path, curve);
+        results[k] = compare_at_tool(problem, variant, at, std::move(curve), load.fem,
+                                     load.compared_vertices, other);
       } catch (...) {
         errors[k] = std::current_exception();
       }
@@ -293,24 +306,23 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       const std::vector<double> path =
           depths.empty() ? std::vector<double>{}
                          : loading_path(depths, tool->depth, parameters.loads.tool.path_step_m);
-      StaticSolution s = press(built, tool, path, r.force_depth);
-      r.inverted_elements = inverted_tetrahedra(built, s.x);
-      r.force_depth_monotone = force_grows_with_depth(r.force_depth, tool);
+      std::vector<ForceDepthPoint> curve;
+      const StaticSolution s = press(built, tool, path, curve);
+      ToolLoadVariant own = compare_at_tool(problem, built, s, std::move(curve), run.fem,
+                                            run.compared_vertices, tool);
+      r.errors = own.errors;
+      r.tool_force = own.tool_force;
+      r.reaction_force_rel_error = own.reaction_force_rel_error;
+      r.volume_change = own.volume_change;
+      r.inverted_elements = own.inverted_elements;
+      r.force_depth_monotone = own.force_depth_monotone;
+      r.force_depth = std::move(own.force_depth);
       if (r.force_depth_monotone == false)
         r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
       r.newton_iterations = s.newton_iterations;
       r.equilibrium = s.x;
       r.surface_displacement = s.surface_displacement;
       r.error = s.surface_displacement - run.fem.surface_displacement;
-      const Eigen::Vector3d zone_center = tool ? tool->contact_point : problem.centroid;
-      const double zone_radius = tool ? 2 * tool->radius : 0.0;
-      r.errors = zoned_displacement_error(s.surface_displacement, run.fem.surface_displacement,
-                                          problem.surface.vertices, run.compared_vertices,
-                                          zone_center, zone_radius);
-      r.tool_force = s.tool_force;
-      if (tool)
-        r.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, run.fem.tool_force);
-      r.volume_change = volume_change(problem.surface, s.surface_displacement);
       if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
       press_other_tools(run, built, path);
       for (const ToolLoad& load : run.other_tools)
@@ -318,7 +330,6 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
           r.warnings.push_back(
               "tool " + std::to_string(load.tool) + ": " +
               force_falls_warning(load.variants.back().force_depth, built.tetrahedra.rows()));
-      if (tool) set_tool_depth(built, *tool);
       run.variants.push_back(std::move(r));
     } catch (const cases::InputError&) {
       throw;
@@ -334,6 +345,23 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
                              ": " + run.failed_variants[0].second);
   run.wall_time_s = seconds_since(start);
   return run;
+}
+
+std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& v) {
+  ToolLoadVariant own;
+  own.name = v.name;
+  own.errors = v.errors;
+  own.tool_force = v.tool_force;
+  own.reaction_force_rel_error = v.reaction_force_rel_error;
+  own.volume_change = v.volume_change;
+  own.inverted_elements = v.inverted_elements;
+  own.force_depth = v.force_depth;
+  own.force_depth_monotone = v.force_depth_monotone;
+  std::vector<ToolLoadVariant> list = {own};
+  for (const auto& load : run.other_tools)
+    for (const auto& o : load.variants)
+      if (o.name == v.name) list.push_back(o);
+  return list;
 }
 
 }  // namespace msfem::compare

@@ -110,20 +110,16 @@ std::string tool_positions_table(const CaseRun& run) {
     md << "---|";
   md << "\n";
   for (const auto& v : run.variants) {
-    double l2 = v.errors.all.rel_l2_error, force = v.reaction_force_rel_error;
+    double l2 = 0.0, force = 0.0;
     char cell[64];
-    std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", l2, force,
-                  v.force_depth_monotone == false ? " †" : "");
-    md << "| " << v.name << " |" << cell;
-    for (const auto& load : run.other_tools)
-      for (const auto& o : load.variants)
-        if (o.name == v.name) {
-          std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
-                        o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
-          md << cell;
-          l2 += o.errors.all.rel_l2_error;
-          force += o.reaction_force_rel_error;
-        }
+    md << "| " << v.name << " |";
+    for (const ToolLoadVariant& o : per_tool(run, v)) {
+      std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
+                    o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
+      md << cell;
+      l2 += o.errors.all.rel_l2_error;
+      force += o.reaction_force_rel_error;
+    }
     std::snprintf(cell, sizeof cell, " %.3f / %.3f |", l2 / tools, force / tools);
     md << cell << "\n";
   }

@@ -36,9 +36,8 @@ nlohmann::json curve_json(const std::vector<ForceDepthPoint>& curve) {
   return points;
 }
 
-nlohmann::json load_json(int tool, const ZonedErrorMetrics& e, const Eigen::Vector3d& force,
-                         double force_error, double volume_change,
-                         const std::optional<int>& inverted, const std::optional<bool>& monotone) {
+nlohmann::json load_json(int tool, const ToolLoadVariant& o) {
+  const ZonedErrorMetrics& e = o.errors;
   return {{"tool", tool},
           {"rel_l2_error", e.all.rel_l2_error},
           {"rms_error_m", e.all.rms_error_m},
@@ -46,31 +45,26 @@ nlohmann::json load_json(int tool, const ZonedErrorMetrics& e, const Eigen::Vect
           {"mean_error_over_max_disp", e.all.mean_error_over_max_disp},
           {"contact_zone", zone(e.contact_zone)},
           {"far_field", zone(e.far_field)},
-          {"reaction_force_N", vec(force)},
-          {"reaction_force_rel_error", force_error},
-          {"volume_change", volume_change},
-          {"inverted_elements", optional_json(inverted)},
-          {"force_depth_monotone", optional_json(monotone)}};
+          {"reaction_force_N", vec(o.tool_force)},
+          {"reaction_force_rel_error", o.reaction_force_rel_error},
+          {"volume_change", o.volume_change},
+          {"inverted_elements", optional_json(o.inverted_elements)},
+          {"force_depth_monotone", optional_json(o.force_depth_monotone)},
+          {"force_depth", curve_json(o.force_depth)}};
 }
 
 // Every tool position of the case as its own load (the first is the variant's own row), with the
 // means a user comparing variants over the case wants.
 nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
   nlohmann::json list = nlohmann::json::array();
-  list.push_back(load_json(0, v.errors, v.tool_force, v.reaction_force_rel_error, v.volume_change,
-                           v.inverted_elements, v.force_depth_monotone));
-  list.back()["force_depth"] = curve_json(v.force_depth);
-  double l2 = v.errors.all.rel_l2_error, force = v.reaction_force_rel_error;
-  for (const auto& load : run.other_tools)
-    for (const auto& o : load.variants)
-      if (o.name == v.name) {
-        list.push_back(load_json(load.tool, o.errors, o.tool_force, o.reaction_force_rel_error,
-                                 o.volume_change, o.inverted_elements, o.force_depth_monotone));
-        list.back()["force_depth"] = curve_json(o.force_depth);
-        l2 += o.errors.all.rel_l2_error;
-        force += o.reaction_force_rel_error;
-      }
-  const double n = static_cast<double>(list.size());
+  double l2 = 0.0, force = 0.0;
+  const std::vector<ToolLoadVariant> loads = per_tool(run, v);
+  for (std::size_t t = 0; t < loads.size(); ++t) {
+    list.push_back(load_json(static_cast<int>(t), loads[t]));
+    l2 += loads[t].errors.all.rel_l2_error;
+    force += loads[t].reaction_force_rel_error;
+  }
+  const double n = static_cast<double>(loads.size());
   return {{"per_tool", list},
           {"mean_rel_l2_error", l2 / n},
           {"mean_reaction_force_rel_error", force / n}};

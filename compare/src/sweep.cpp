@@ -38,50 +38,47 @@ cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
   return p;
 }
 
-// One resolution's points, appended to `points` (nothing is appended if it fails).
-void sweep_resolution(const cases::CaseParameters& parameters, int resolution,
-                      const SweepSettings& settings,
-                      const std::filesystem::path& fem_cache_directory,
-                      std::vector<SweepPoint>& all_points) {
+// One resolution's points: every variant with every integrator.
+std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
+                                         const SweepSettings& settings,
+                                         const std::filesystem::path& fem_cache_directory) {
   std::vector<SweepPoint> points;
-  {
-    const cases::CaseParameters p = at_resolution(parameters, resolution);
-    RunSettings run_settings;
-    run_settings.quiet = true;
-    run_settings.force_depth_curve = false;
-    run_settings.time_dynamics = false;
-    run_settings.all_tools = false;  // accuracy against speed at the case's first tool
-    run_settings.fem_cache_directory = fem_cache_directory;
-    const CaseRun run = run_case(p, run_settings);
-    const std::optional<ToolPlacement> tool =
-        run.problem.tools.empty() ? std::nullopt
-                                  : std::optional<ToolPlacement>(run.problem.tools.front());
-    for (const auto& v : run.variants) {
-      const BuiltVariant built = build_variant(v.name, run.problem, run.mesh, tool);
-      const Eigen::VectorXd& equilibrium = v.equilibrium;  // run_case's, from rest as here
-      for (const auto& integrator : settings.integrators) {
-        cases::TimingParameters timing = p.timing;
-        timing.integrator = integrator;
-        timing.dt_s = 0.0;  // each integrator at half its own stable step
-        const Timing t = time_variant(built, timing, equilibrium, /*measure_settling=*/false);
-        SweepPoint pt;
-        pt.variant = v.name;
-        pt.integrator = integrator;
-        pt.resolution = resolution;
-        pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
-        pt.nodes = v.nodes;
-        pt.springs = v.springs;
-        pt.rel_l2_error = v.errors.all.rel_l2_error;
-        pt.reaction_force_rel_error = v.reaction_force_rel_error;
-        pt.stable_dt_s = t.stable_dt_s;
-        pt.steps_per_second = t.steps_per_second;
-        pt.realtime_factor = t.realtime_factor;
-        pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
-        points.push_back(pt);
-      }
+  const cases::CaseParameters p = at_resolution(parameters, resolution);
+  RunSettings run_settings;
+  run_settings.quiet = true;
+  run_settings.force_depth_curve = false;
+  run_settings.time_dynamics = false;
+  run_settings.all_tools = false;  // accuracy against speed at the case's first tool
+  run_settings.fem_cache_directory = fem_cache_directory;
+  const CaseRun run = run_case(p, run_settings);
+  const std::optional<ToolPlacement> tool =
+      run.problem.tools.empty() ? std::nullopt
+                                : std::optional<ToolPlacement>(run.problem.tools.front());
+  for (const auto& v : run.variants) {
+    const BuiltVariant built = build_variant(v.name, run.problem, run.mesh, tool);
+    const Eigen::VectorXd& equilibrium = v.equilibrium;  // run_case's, from rest as here
+    for (const auto& integrator : settings.integrators) {
+      cases::TimingParameters timing = p.timing;
+      timing.integrator = integrator;
+      timing.dt_s = 0.0;  // each integrator at half its own stable step
+      const Timing t = time_variant(built, timing, equilibrium, /*measure_settling=*/false);
+      SweepPoint pt;
+      pt.variant = v.name;
+      pt.integrator = integrator;
+      pt.resolution = resolution;
+      pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
+      pt.nodes = v.nodes;
+      pt.springs = v.springs;
+      pt.rel_l2_error = v.errors.all.rel_l2_error;
+      pt.reaction_force_rel_error = v.reaction_force_rel_error;
+      pt.stable_dt_s = t.stable_dt_s;
+      pt.steps_per_second = t.steps_per_second;
+      pt.realtime_factor = t.realtime_factor;
+      pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
+      points.push_back(pt);
     }
   }
-  all_points.insert(all_points.end(), points.begin(), points.end());
+  return points;
 }
 
 }  // namespace
@@ -97,7 +94,10 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   std::exception_ptr first_failure;
   for (std::size_t r = 0; r < resolutions.size(); ++r) {
     try {
-      sweep_resolution(parameters, resolutions[r], settings, fem_cache_directory, points);
+      // All of a resolution's points or none of them.
+      const std::vector<SweepPoint> more =
+          sweep_resolution(parameters, resolutions[r], settings, fem_cache_directory);
+      points.insert(points.end(), more.begin(), more.end());
     } catch (const std::exception& e) {
       if (!first_failure) first_failure = std::current_exception();
       result.failed_resolutions.emplace_back(resolutions[r], e.what());

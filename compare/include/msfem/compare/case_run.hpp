@@ -115,6 +115,10 @@ std::vector<double> curve_depths(const cases::ToolParameters& tool);
 /// increasing order, with equal steps no longer than `step` (> 0) inserted from 0 up to each.
 std::vector<double> loading_path(std::vector<double> depths, double case_depth, double step);
 
+/// The variant at every tool position of the run, in tool order: tool 0 from its own result, then
+/// the other tools' (what summary.json's `loads` and report.md's per-tool table show).
+std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& variant);
+
 /// Whether the force the tissue exerts on the tool, along the tool's outward normal, grows strictly
 /// from each depth of the curve to the next deeper one; none without a tool or with fewer than
 /// two points.
