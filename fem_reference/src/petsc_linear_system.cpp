@@ -273,7 +273,12 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
   KSPDestroy(&ksp);
   MatNullSpaceDestroy(&rigid_body_modes);
   VecDestroy(&coordinates);
-  if (solve_code != 0 || reason < 0)
+  if (solve_code != 0)  // PETSc has printed its own trace; name the failing stage here
+    throw SolverError(std::string(method_name(settings.preconditioner)) + " failed: PETSc error " +
+                      std::to_string(int(solve_code)) + " in KSPSolve after " +
+                      std::to_string(iterations) + " iterations" +
+                      (iterations == 0 ? " (in the preconditioner's set-up or an option)" : ""));
+  if (reason < 0)
     throw SolverError(std::string(method_name(settings.preconditioner)) + " did not converge: " +
                       reason_text(reason) + " after " + std::to_string(iterations) +
                       " iterations, residual norm " + scientific(double(residual)) +

@@ -1,8 +1,11 @@
 #include "msfem/fem_reference/volume_mesh.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace msfem::fem_reference {
 
@@ -44,6 +47,47 @@ void check_volume_mesh(const VolumeMesh& mesh) {
     if (!(signed_tetrahedron_volume(mesh, e) > 0.0))
       throw std::invalid_argument("tetrahedron " + std::to_string(e) + " has non-positive volume");
   }
+}
+
+std::vector<unsigned int> partition_cells(const VolumeMesh& mesh, unsigned int parts) {
+  const std::size_t n = std::size_t(mesh.num_tetrahedra());
+  std::vector<Eigen::Vector3d> centroid(n);
+  for (std::size_t e = 0; e < n; ++e) {
+    centroid[e].setZero();
+    for (int k = 0; k < 4; ++k)
+      centroid[e] += 0.25 * mesh.vertices.row(mesh.tetrahedra(Eigen::Index(e), k)).transpose();
+  }
+  std::vector<std::size_t> cells(n);
+  for (std::size_t e = 0; e < n; ++e)
+    cells[e] = e;
+  std::vector<unsigned int> part(n, 0);
+  const std::function<void(std::size_t, std::size_t, unsigned int, unsigned int)> split =
+      [&](std::size_t begin, std::size_t end, unsigned int first_part, unsigned int count) {
+        if (count <= 1 || end - begin < 2) {
+          for (std::size_t i = begin; i < end; ++i)
+            part[cells[i]] = first_part;
+          return;
+        }
+        Eigen::Vector3d low = centroid[cells[begin]], high = low;
+        for (std::size_t i = begin; i < end; ++i) {
+          low = low.cwiseMin(centroid[cells[i]]);
+          high = high.cwiseMax(centroid[cells[i]]);
+        }
+        Eigen::Index axis = 0;
+        (high - low).maxCoeff(&axis);
+        const unsigned int left_parts = count / 2;
+        const std::size_t middle = begin + (end - begin) * left_parts / count;
+        std::nth_element(cells.begin() + std::ptrdiff_t(begin),
+                         cells.begin() + std::ptrdiff_t(middle),
+                         cells.begin() + std::ptrdiff_t(end), [&](std::size_t a, std::size_t b) {
+                           return centroid[a][axis] < centroid[b][axis] ||
+                                  (centroid[a][axis] == centroid[b][axis] && a < b);
+                         });
+        split(begin, middle, first_part, left_parts);
+        split(middle, end, first_part + left_parts, count - left_parts);
+      };
+  split(0, n, 0, parts);
+  return part;
 }
 
 }  // namespace msfem::fem_reference

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -43,6 +44,41 @@ TEST(SurfaceMesher, KeepsEverySurfaceVertexAsMeshVertex) {
   const Eigen::VectorXd masses = lumped_vertex_masses(mesh, 1040.0);
   EXPECT_NEAR(masses.sum(), 1040.0 * volume(mesh), 1e-12 * masses.sum());
   EXPECT_GT(masses.minCoeff(), 0.0);
+}
+
+TEST(VolumeMesh, PartitionsCellsIntoEqualSlabs) {
+  const testing::TestSurface sphere = testing::icosphere(3, 0.05);
+  const VolumeMesh mesh = mesh_closed_surface(sphere.vertices, sphere.triangles);
+  const auto n = std::size_t(mesh.num_tetrahedra());
+  for (unsigned int parts : {1u, 2u, 3u, 5u}) {
+    const std::vector<unsigned int> part = partition_cells(mesh, parts);
+    ASSERT_EQ(part.size(), n);
+    std::vector<std::size_t> size(parts, 0);
+    for (unsigned int p : part) {
+      ASSERT_LT(p, parts);
+      ++size[p];
+    }
+    const auto [smallest, largest] = std::minmax_element(size.begin(), size.end());
+    EXPECT_LE(*largest - *smallest, parts) << parts << " parts";
+    EXPECT_EQ(partition_cells(mesh, parts), part) << "not deterministic";
+  }
+  // Two parts: one cut plane, normal to an axis, separates the centroids.
+  const std::vector<unsigned int> half = partition_cells(mesh, 2);
+  std::vector<Eigen::Vector3d> centroids(n);
+  for (std::size_t e = 0; e < n; ++e) {
+    centroids[e].setZero();
+    for (int k = 0; k < 4; ++k)
+      centroids[e] += 0.25 * mesh.vertices.row(mesh.tetrahedra(Eigen::Index(e), k)).transpose();
+  }
+  bool separated_on_some_axis = false;
+  for (int axis = 0; axis < 3; ++axis) {
+    double max0 = -1e300, min1 = 1e300;
+    for (std::size_t e = 0; e < n; ++e)
+      (half[e] == 0 ? max0 : min1) =
+          half[e] == 0 ? std::max(max0, centroids[e][axis]) : std::min(min1, centroids[e][axis]);
+    separated_on_some_axis |= max0 <= min1;
+  }
+  EXPECT_TRUE(separated_on_some_axis);
 }
 
 TEST(SurfaceMesher, RefinesNearTheTool) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 namespace msfem::fem_reference {
 
@@ -32,5 +33,12 @@ Eigen::VectorXd lumped_vertex_masses(const VolumeMesh& mesh, double density);
 /// Throws std::invalid_argument (one line naming the item) unless every tetrahedron refers to
 /// existing vertices and has positive volume.
 void check_volume_mesh(const VolumeMesh& mesh);
+
+/// The part (0 .. parts - 1) of each tetrahedron: recursive coordinate bisection of the centroids,
+/// each cut at the weighted median along the longest side of the part's box, so part sizes differ
+/// by at most one cell per cut and interfaces are planar. Deterministic. The FEM's MPI partition:
+/// it replaced METIS, whose cell graph cost 7 s of a 2-rank, 1.9 M-cell set-up, at no loss for the
+/// compact organs and shapes meshed here (same CG iterations).
+std::vector<unsigned int> partition_cells(const VolumeMesh& mesh, unsigned int parts);
 
 }  // namespace msfem::fem_reference
