@@ -18,7 +18,8 @@
 
 namespace msfem::fem_reference::detail {
 class PetscLinearSystem;
-}
+struct CoarseSpace;
+}  // namespace msfem::fem_reference::detail
 
 namespace msfem::fem_reference {
 
@@ -44,6 +45,9 @@ struct ElasticityProblem::Implementation {
   void locate_dof_support_points();
   void collect_prescribed_dofs();
   Eigen::Vector3d evaluate(const PointLocation& location) const;
+  /// P2 only: the P1 space of the same mesh as the preconditioner's coarse level
+  /// (coarse_space.cpp).
+  detail::CoarseSpace p1_coarse_space() const;
 
   MPI_Comm communicator;
   VolumeMesh mesh;

@@ -3,6 +3,7 @@
 #include <mpi.h>
 #include <petscksp.h>
 
+#include <utility>
 #include <vector>
 
 #include "msfem/fem_reference/elasticity_problem.hpp"
@@ -22,6 +23,17 @@ struct KrylovReport {
 /// block size 3 (DoFs interleaved x, y, z per node) and the rigid-body near-null space for GAMG,
 /// symmetric elimination of prescribed DoFs (MatZeroRowsColumns) and the KSP set-up. Each rank owns
 /// the contiguous rows [first_owned_row, first_owned_row + owned_rows).
+/// A coarser space on the same mesh (P1 below P2) for a two-level preconditioner: the
+/// interpolation's owned rows in CSR form (fine DoF -> coarse DoFs and weights, DoFs interleaved
+/// x, y, z per node in both spaces), the number of coarse DoFs this rank owns (whole nodes, in
+/// rank order), and x, y, z of each owned coarse node (for GAMG's rigid-body modes on it).
+struct CoarseSpace {
+  PetscInt owned_coarse_rows = 0;
+  std::vector<PetscInt> row_begin, columns;
+  std::vector<double> weights;
+  std::vector<double> node_coordinates;
+};
+
 class PetscLinearSystem {
  public:
   PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows, PetscInt first_owned_row,
@@ -42,6 +54,10 @@ class PetscLinearSystem {
   void apply_prescribed_values(const std::vector<PetscInt>& rows,
                                const std::vector<double>& values);
 
+  /// With a coarse space, CG + GAMG becomes CG + a two-level V-cycle: Chebyshev with point-block
+  /// Jacobi on this matrix, one GAMG V-cycle on the Galerkin product P^T K P as the coarse solve.
+  void set_coarse_space(CoarseSpace space) { coarse_space_ = std::move(space); }
+
   /// Solves with the chosen method; `owned_node_coordinates` holds x, y, z of the node of each
   /// owned DoF triple (for the rigid-body modes). Throws SolverError when not converged.
   KrylovReport solve(const SolverSettings& settings,
@@ -54,6 +70,7 @@ class PetscLinearSystem {
   MPI_Comm communicator_;
   PetscInt first_owned_row_, owned_rows_;
   Mat matrix_ = nullptr;
+  CoarseSpace coarse_space_;
   Vec rhs_ = nullptr, solution_ = nullptr;
   // Scratch of add_cell.
   std::vector<std::size_t> order_;

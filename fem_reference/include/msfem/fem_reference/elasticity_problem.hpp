@@ -59,6 +59,9 @@ struct SolverSettings {
   Preconditioner preconditioner = Preconditioner::gamg;
   double relative_tolerance = 1e-10;  ///< on the preconditioned residual norm
   int max_iterations = 2000;
+  /// P2 with GAMG: precondition with two levels, the P2 space over the P1 space of the same mesh
+  /// (GAMG on that), instead of GAMG on the P2 matrix: about half the CG iterations on the brain.
+  bool p_multigrid = true;
 };
 
 /// Everything the FEM needs besides the mesh.
