@@ -265,7 +265,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
           depths[i] == tool->depth
               ? run.fem.tool_force
               : solve_fem(problem, run.mesh, at_depth(*tool, depths[i])).tool_force;
-      run.fem_force_depth.push_back({depths[i], force});
+      run.fem_force_depth.push_back({depths[i], force, std::nullopt});
       progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
                        static_cast<int>(depths.size()), seconds_since(curve_start));
     }

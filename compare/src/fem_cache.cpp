@@ -108,7 +108,7 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     s.statistics.assemble_time_s = st.at("assemble_time_s");
     s.statistics.solve_time_s = st.at("solve_time_s");
     for (const auto& p : j.at("force_depth"))
-      e.force_depth.push_back({p.at("depth_m"), vec_from(p.at("force_N"))});
+      e.force_depth.push_back({p.at("depth_m"), vec_from(p.at("force_N")), std::nullopt});
     if (j.contains("other_tools"))
       for (const auto& o : j.at("other_tools")) {
         FemSolution t;

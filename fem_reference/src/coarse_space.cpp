@@ -40,13 +40,17 @@ detail::CoarseSpace ElasticityProblem::Implementation::p1_coarse_space() const {
     for (unsigned int i = 0; i < dofs.size(); ++i) {
       if (fe.system_to_component_index(i).first != 0) continue;
       const auto b = barycentric(unit[i]);
+      // A vertex (one coordinate 1) is its own parent twice; an edge midpoint (two of 1/2) has two.
       std::array<long, 2> p{{unset, unset}};
-      int found = 0;
-      for (int k = 0; k < 4; ++k)
-        if (std::abs(b[std::size_t(k)] - 1.0) < 1e-12)
-          p = {vertex_node[std::size_t(k)], vertex_node[std::size_t(k)]}, found = 2;
-        else if (std::abs(b[std::size_t(k)] - 0.5) < 1e-12 && found < 2)
-          p[std::size_t(found++)] = vertex_node[std::size_t(k)];
+      std::size_t found = 0;
+      for (std::size_t k = 0; k < 4 && found < 2; ++k) {
+        if (std::abs(b[k] - 1.0) < 1e-12) {
+          p = {vertex_node[k], vertex_node[k]};
+          found = 2;
+        } else if (std::abs(b[k] - 0.5) < 1e-12) {
+          p[found++] = vertex_node[k];
+        }
+      }
       if (found != 2 || p[0] == unset || p[1] == unset)
         throw FemError("P2 support point of cell " + std::to_string(cell->active_cell_index()) +
                        " is neither a vertex nor an edge midpoint");
