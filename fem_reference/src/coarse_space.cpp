@@ -21,7 +21,7 @@ detail::CoarseSpace ElasticityProblem::Implementation::p1_coarse_space() const {
   // edge's vertices. Read from the barycentric coordinates of the element's support points, so no
   // assumption on deal.II's edge numbering.
   constexpr long unset = -1;
-  std::vector<std::array<long, 2>> parents(n_nodes, {unset, unset});
+  std::vector<std::array<long, 2>> parents(n_nodes, {{unset, unset}});
   const std::vector<Point<d>>& unit = fe.get_unit_support_points();
   std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
   const auto barycentric = [](const Point<d>& x) {
@@ -45,7 +45,7 @@ detail::CoarseSpace ElasticityProblem::Implementation::p1_coarse_space() const {
       std::size_t found = 0;
       for (std::size_t k = 0; k < 4 && found < 2; ++k) {
         if (std::abs(b[k] - 1.0) < 1e-12) {
-          p = {vertex_node[k], vertex_node[k]};
+          p = {{vertex_node[k], vertex_node[k]}};
           found = 2;
         } else if (std::abs(b[k] - 0.5) < 1e-12) {
           p[found++] = vertex_node[k];
