@@ -184,18 +184,15 @@ struct NodeGatherLayout {
 
 // The linearised backward-Euler system of one step in slot and lane order (fast implicit stepper):
 // per slot y += α q + (e·q) e for q = p_j - p_i, stored per group of W slots as W α, then W of each
-// component of e (one stream for the product to read); per lane the diagonal term m + h c + h² k_a,
-// and the right-hand side.
+// component of e (one stream for the product to read); per lane the diagonal term m + h c + h² k_a.
 template <class Real>
 struct ImplicitCoefficients {
-  AlignedVector<Real> slot_terms;   // 4 per slot
-  AlignedVector<Real> own, rhs[3];  // per lane
+  AlignedVector<Real> slot_terms;  // 4 per slot
+  AlignedVector<Real> own;         // per lane
 
   void resize(std::size_t slots, std::size_t lanes) {
     slot_terms.assign(4 * slots, Real(0));
     own.assign(lanes, Real(1));
-    for (auto& v : rhs)
-      v.assign(lanes, Real(0));
   }
 };
 
