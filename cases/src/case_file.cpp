@@ -140,8 +140,9 @@ void declare_fem_timing_output(ParameterHandler& prm) {
   prm.declare_entry("cell size", "0", Patterns::Double(0),
                     "Target tetrahedron size (m); 0: the surface's mean edge length.");
   prm.declare_entry("solver", "cg_gamg", Patterns::Selection("cg_gamg|cg_boomeramg|mumps"),
-                    "PETSc solver: CG with GAMG (rigid-body near-null space), CG with hypre "
-                    "BoomerAMG, or the MUMPS direct solver.");
+                    "PETSc solver: CG with GAMG (rigid-body near-null space; at degree 2 GAMG "
+                    "acts on the mesh's P1 level below a Chebyshev-smoothed P2 level), CG with "
+                    "hypre BoomerAMG, or the MUMPS direct solver.");
   prm.declare_entry("relative tolerance", "1e-10", Patterns::Double(0, 1),
                     "Relative residual at which the iterative solver stops.");
   prm.declare_entry(
