@@ -11,7 +11,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -324,6 +323,12 @@ double ElasticityProblem::equilibrium_defect() const {
 void ElasticityProblem::Implementation::setup_system() {
   const auto start = Clock::now();
   create_triangulation(mesh, triangulation);
+  // The partition comes from the create signal; should a deal.II version stop emitting it before
+  // the owners are recorded, rank 0 would silently own everything.
+  const unsigned int ranks = Utilities::MPI::n_mpi_processes(communicator);
+  if (ranks > 1 && triangulation.n_active_cells() >= ranks &&
+      Utilities::MPI::min(triangulation.n_locally_owned_active_cells(), communicator) == 0)
+    throw FemError("the mesh partition left a rank without cells");
   cell_of_tetrahedron.assign(std::size_t(mesh.num_tetrahedra()), dof_handler.end());
   dof_handler.distribute_dofs(fe);
   for (const auto& cell : dof_handler.active_cell_iterators()) {
