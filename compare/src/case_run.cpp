@@ -298,7 +298,6 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     BuiltVariant built = build_variant(name, problem, run.mesh, tool);
     try {
       VariantResult r;
-      r.name = name;
       r.nodes = built.model->num_nodes();
       r.springs = built.model->network().num_springs();
       r.warnings = built.warnings;
@@ -308,15 +307,8 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
                          : loading_path(depths, tool->depth, parameters.loads.tool.path_step_m);
       std::vector<ForceDepthPoint> curve;
       const StaticSolution s = press(built, tool, path, curve);
-      ToolLoadVariant own = compare_at_tool(problem, built, s, std::move(curve), run.fem,
-                                            run.compared_vertices, tool);
-      r.errors = own.errors;
-      r.tool_force = own.tool_force;
-      r.reaction_force_rel_error = own.reaction_force_rel_error;
-      r.volume_change = own.volume_change;
-      r.inverted_elements = own.inverted_elements;
-      r.force_depth_monotone = own.force_depth_monotone;
-      r.force_depth = std::move(own.force_depth);
+      static_cast<ToolLoadVariant&>(r) = compare_at_tool(problem, built, s, std::move(curve),
+                                                         run.fem, run.compared_vertices, tool);
       if (r.force_depth_monotone == false)
         r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
       r.newton_iterations = s.newton_iterations;
@@ -348,16 +340,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 }
 
 std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& v) {
-  ToolLoadVariant own;
-  own.name = v.name;
-  own.errors = v.errors;
-  own.tool_force = v.tool_force;
-  own.reaction_force_rel_error = v.reaction_force_rel_error;
-  own.volume_change = v.volume_change;
-  own.inverted_elements = v.inverted_elements;
-  own.force_depth = v.force_depth;
-  own.force_depth_monotone = v.force_depth_monotone;
-  std::vector<ToolLoadVariant> list = {own};
+  std::vector<ToolLoadVariant> list = {static_cast<const ToolLoadVariant&>(v)};
   for (const auto& load : run.other_tools)
     for (const auto& o : load.variants)
       if (o.name == v.name) list.push_back(o);

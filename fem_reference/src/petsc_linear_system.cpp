@@ -69,6 +69,23 @@ void finest_smoother_point_block_jacobi(KSP ksp, PC pc) {
   KSPSetUp(smoother);  // a failure here shows in KSPSolve's converged reason (GAMG's fallback)
 }
 
+/// The three translations and three rotations, built by PETSc from the owned rows' node coordinates
+/// (x, y, z per node, block size 3), as `matrix`'s near-null space: what makes smoothed
+/// aggregation work for elasticity. The caller destroys `coordinates` and `modes`.
+void set_rigid_body_modes(MPI_Comm communicator, Mat matrix,
+                          const std::vector<double>& owned_node_coordinates, Vec& coordinates,
+                          MatNullSpace& modes) {
+  const auto rows = PetscInt(owned_node_coordinates.size());
+  MSFEM_PETSC(VecCreateMPI(communicator, rows, PETSC_DETERMINE, &coordinates));
+  MSFEM_PETSC(VecSetBlockSize(coordinates, 3));
+  double* c = nullptr;
+  MSFEM_PETSC(VecGetArray(coordinates, &c));
+  std::copy(owned_node_coordinates.begin(), owned_node_coordinates.end(), c);
+  MSFEM_PETSC(VecRestoreArray(coordinates, &c));
+  MSFEM_PETSC(MatNullSpaceCreateRigidBody(coordinates, &modes));
+  MSFEM_PETSC(MatSetNearNullSpace(matrix, modes));
+}
+
 /// What two_level_preconditioner creates, destroyed after the solve.
 struct TwoLevel {
   Mat interpolation = nullptr, coarse = nullptr;
@@ -124,15 +141,8 @@ void two_level_preconditioner(MPI_Comm communicator, Mat fine, const CoarseSpace
   MSFEM_PETSC(MatPtAP(fine, t.interpolation, MAT_INITIAL_MATRIX, 2.0, &t.coarse));
   MSFEM_PETSC(MatSetOption(t.coarse, MAT_SYMMETRIC, PETSC_TRUE));
 
-  MSFEM_PETSC(VecCreateMPI(communicator, space.owned_coarse_rows, PETSC_DETERMINE, &t.coordinates));
-  MSFEM_PETSC(VecSetBlockSize(t.coordinates, 3));
-  double* c = nullptr;
-  MSFEM_PETSC(VecGetArray(t.coordinates, &c));
-  for (PetscInt i = 0; i < space.owned_coarse_rows; ++i)
-    c[i] = space.node_coordinates[std::size_t(i)];
-  MSFEM_PETSC(VecRestoreArray(t.coordinates, &c));
-  MSFEM_PETSC(MatNullSpaceCreateRigidBody(t.coordinates, &t.rigid_body_modes));
-  MSFEM_PETSC(MatSetNearNullSpace(t.coarse, t.rigid_body_modes));
+  set_rigid_body_modes(communicator, t.coarse, space.node_coordinates, t.coordinates,
+                       t.rigid_body_modes);
 
   MSFEM_PETSC(PCSetType(pc, PCMG));
   MSFEM_PETSC(PCMGSetLevels(pc, 2, nullptr));
@@ -329,17 +339,8 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
     MSFEM_PETSC(KSPSetType(ksp, KSPCG));
     MSFEM_PETSC(
         KSPSetTolerances(ksp, settings.relative_tolerance, 1e-300, 1e10, settings.max_iterations));
-    // The three translations and three rotations, built by PETSc from the node coordinates
-    // (block size 3): the near-null space that makes smoothed aggregation work for elasticity.
-    MSFEM_PETSC(VecCreateMPI(communicator_, owned_rows_, PETSC_DETERMINE, &coordinates));
-    MSFEM_PETSC(VecSetBlockSize(coordinates, 3));
-    double* c = nullptr;
-    MSFEM_PETSC(VecGetArray(coordinates, &c));
-    for (PetscInt i = 0; i < owned_rows_; ++i)
-      c[i] = owned_node_coordinates[std::size_t(i)];
-    MSFEM_PETSC(VecRestoreArray(coordinates, &c));
-    MSFEM_PETSC(MatNullSpaceCreateRigidBody(coordinates, &rigid_body_modes));
-    MSFEM_PETSC(MatSetNearNullSpace(matrix_, rigid_body_modes));
+    set_rigid_body_modes(communicator_, matrix_, owned_node_coordinates, coordinates,
+                         rigid_body_modes);
     if (settings.preconditioner == Preconditioner::gamg) {
       if (coarse_space_.row_begin.empty())
         MSFEM_PETSC(PCSetType(pc, PCGAMG));

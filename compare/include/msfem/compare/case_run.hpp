@@ -36,27 +36,9 @@ struct ForceDepthPoint {
   std::optional<int> inverted_elements;  ///< a volumetric variant's inverted tetrahedra there
 };
 
-struct VariantResult {
-  std::string name;
-  int nodes = 0, springs = 0;
-  ZonedErrorMetrics errors;
-  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
-  double reaction_force_rel_error = 0.0;
-  double volume_change = 0.0;
-  Timing timing;
-  int newton_iterations = 0;
-  nlohmann::json parameters;  ///< group stiffness, damping, masses as used
-  std::vector<std::string> warnings;
-  Eigen::VectorXd equilibrium;            ///< every node's position at the case's load, m
-  Eigen::MatrixX3d surface_displacement;  ///< at the surface vertices, m
-  Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
-  std::vector<ForceDepthPoint> force_depth;
-  std::optional<bool> force_depth_monotone;  ///< none without a curve
-  std::optional<int> inverted_elements;      ///< at the case's load; none for surface networks
-};
-
-/// One variant at one more of the case's tool positions (the second and later
-/// `loads/tool/directions`), at the case's depth, reached along the same loading path.
+/// One variant pressed at one of the case's tool positions, at the case's depth, reached along the
+/// loading path: alone for the second and later `loads/tool/directions`, within VariantResult for
+/// the first.
 struct ToolLoadVariant {
   std::string name;
   ZonedErrorMetrics errors;
@@ -66,6 +48,18 @@ struct ToolLoadVariant {
   std::optional<int> inverted_elements;
   std::vector<ForceDepthPoint> force_depth;  ///< every step of its loading path
   std::optional<bool> force_depth_monotone;  ///< along its loading path
+};
+
+/// The variant at the run's own (first) tool position, with what only that load gets.
+struct VariantResult : ToolLoadVariant {
+  int nodes = 0, springs = 0;
+  Timing timing;
+  int newton_iterations = 0;
+  nlohmann::json parameters;  ///< group stiffness, damping, masses as used
+  std::vector<std::string> warnings;
+  Eigen::VectorXd equilibrium;            ///< every node's position at the case's load, m
+  Eigen::MatrixX3d surface_displacement;  ///< at the surface vertices, m
+  Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
 };
 
 /// The FEM and every variant pressed at problem.tools[tool], tool >= 1 (tool 0 is the run's own
