@@ -3,12 +3,14 @@
 // parallel efficiency from 1 to N ranks is the ratio of two such runs, taken back to back.
 //
 //   fem_reference_bench sphere|brain [--degree 1|2] [--cell-size M] [--level L] [--algorithm 1|10]
+//                       [--relocate 0|1]
 //
 // sphere: icosphere of radius 5 cm (level L, default 5), inner core (surface / 2) fixed, a 5 mm
 // tool pressed 5 mm at the pole. brain: cases/data/brain_icbm152_lh_9177_mm.obj, base below z = -30
 // mm fixed, a 5 mm tool pressed 4 mm at the top. Both refine to half the cell size within 1 cm of
 // the tool, as `msfem run` does. Meshing runs on rank 0 (the problem broadcasts rank 0's mesh). One
-// JSON object on stdout; PETSc options (PETSC_OPTIONS, e.g. GAMG's) apply to the solve.
+// JSON object on stdout (with the worst cell's quality, see cell_quality); PETSc options
+// (PETSC_OPTIONS, e.g. GAMG's) apply to the solve.
 #include <mpi.h>
 #include <sys/resource.h>
 
@@ -76,6 +78,7 @@ struct Settings {
   double cell_size = 0.0;
   int level = 5;
   int algorithm = 1;
+  bool relocate = true;  ///< MeshOptions::relocate_interior_vertices
 };
 
 Settings parse(int argc, char** argv) {
@@ -94,6 +97,8 @@ Settings parse(int argc, char** argv) {
       s.level = std::stoi(value);
     else if (key == "--algorithm")
       s.algorithm = std::stoi(value);
+    else if (key == "--relocate")
+      s.relocate = std::stoi(value) != 0;
     else
       throw std::invalid_argument("unknown option '" + key + "'");
   }
@@ -150,6 +155,7 @@ int main(int argc, char** argv) {
     fem_reference::MeshOptions mesh_options;
     mesh_options.cell_size = settings.cell_size;
     mesh_options.algorithm_3d = settings.algorithm;
+    mesh_options.relocate_interior_vertices = settings.relocate;
     mesh_options.refinements.push_back({setup.tool.contact_point, 2 * setup.tool.radius,
                                         2 * setup.tool.radius, 0.5 * settings.cell_size});
     const auto mesh_start = Clock::now();
@@ -159,6 +165,7 @@ int main(int argc, char** argv) {
                                                 mesh_options);
     const double mesh_s = seconds_since(mesh_start);
     const double rss_after_mesh = peak_rss_mb();
+    const double worst_quality = rank == 0 ? fem_reference::cell_quality(mesh).minCoeff() : 0.0;
 
     fem_reference::ElasticityModel model;
     model.degree = settings.degree;
@@ -181,7 +188,8 @@ int main(int argc, char** argv) {
     if (rank == 0)
       std::printf(
           "{\"shape\": \"%s\", \"degree\": %u, \"cell_size_m\": %g, \"algorithm_3d\": %d, "
-          "\"mpi_ranks\": %d, \"dofs\": %zu, \"cells\": %zu, \"vertices\": %zu, "
+          "\"relocate\": %d, \"worst_cell_quality\": %.4f, \"mpi_ranks\": %d, \"dofs\": %zu, "
+          "\"cells\": %zu, \"vertices\": %zu, "
           "\"iterations\": %d, \"mesh_s\": %.3f, \"setup_s\": %.3f, \"assemble_s\": %.3f, "
           "\"solve_s\": %.3f, \"problem_s\": %.3f, \"problem_cpu_s_rank0\": %.3f, "
           "\"mesh_assemble_solve_s\": %.3f, "
@@ -189,10 +197,10 @@ int main(int argc, char** argv) {
           "\"peak_rss_mb_rank0_after_mesh\": %.0f, \"peak_rss_mb_largest_rank\": %.0f, "
           "\"peak_rss_mb_all_ranks\": %.0f, \"load_average_before\": \"%s\", "
           "\"load_average_after\": \"%s\", \"petsc_options\": \"%s\"}\n",
-          settings.shape.c_str(), settings.degree, settings.cell_size, settings.algorithm, ranks,
-          st.dofs, st.cells, st.vertices, st.iterations, mesh_s, st.setup_time_s,
-          st.assemble_time_s, st.solve_time_s, problem_s, problem_cpu_s,
-          mesh_s + st.assemble_time_s + st.solve_time_s, total_s, force.z(),
+          settings.shape.c_str(), settings.degree, settings.cell_size, settings.algorithm,
+          int(settings.relocate), worst_quality, ranks, st.dofs, st.cells, st.vertices,
+          st.iterations, mesh_s, st.setup_time_s, st.assemble_time_s, st.solve_time_s, problem_s,
+          problem_cpu_s, mesh_s + st.assemble_time_s + st.solve_time_s, total_s, force.z(),
           problem.equilibrium_defect(), rss_after_mesh, rss_max, rss_sum, load_before.c_str(),
           load_average().c_str(), petsc_options().c_str());
   } catch (const std::exception& e) {

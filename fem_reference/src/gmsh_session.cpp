@@ -30,9 +30,10 @@ GmshSession::~GmshSession() {
   gmsh::finalize();
 }
 
-VolumeMesh generate_tetrahedra(std::size_t num_kept_nodes) {
+VolumeMesh generate_tetrahedra(std::size_t num_kept_nodes, bool relocate_interior_vertices) {
   try {
     gmsh::model::mesh::generate(3);
+    if (relocate_interior_vertices) gmsh::model::mesh::optimize("Relocate3D");
   } catch (...) {
     std::string message;
     gmsh::logger::getLastError(message);

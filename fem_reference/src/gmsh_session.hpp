@@ -23,7 +23,9 @@ class GmshSession {
 
 /// Runs Gmsh's 3D mesher and returns its linear tetrahedra. Nodes with tags 1..num_kept_nodes come
 /// first, in tag order (the given surface's vertices); the other nodes used by a tetrahedron follow
-/// in tag order. Tetrahedra are reoriented to positive volume.
-VolumeMesh generate_tetrahedra(std::size_t num_kept_nodes);
+/// in tag order. Tetrahedra are reoriented to positive volume. With `relocate_interior_vertices`,
+/// Gmsh's "Relocate3D" pass then moves the volume's own vertices (never boundary ones) to raise the
+/// worst cells' quality.
+VolumeMesh generate_tetrahedra(std::size_t num_kept_nodes, bool relocate_interior_vertices = false);
 
 }  // namespace msfem::fem_reference::detail

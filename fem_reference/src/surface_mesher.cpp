@@ -119,7 +119,11 @@ VolumeMesh mesh_closed_surface(const Eigen::MatrixX3d& vertices, const Eigen::Ma
         return target_size(options, global_size, Eigen::Vector3d(x, y, z));
       });
 
-  VolumeMesh mesh = detail::generate_tetrahedra(node_tags.size());
+  VolumeMesh mesh =
+      detail::generate_tetrahedra(node_tags.size(), options.relocate_interior_vertices);
+  // Node-to-node comparison with the mass-spring surface needs the surface vertices untouched.
+  if (mesh.vertices.topRows(vertices.rows()) != vertices)
+    throw FemError("Gmsh moved a surface vertex while meshing the volume");
   // Boundary recovery may add Steiner points on the surface; then vertex i would no longer be the
   // only boundary node near surface vertex i. Compare the boundary faces with the input triangles.
   // Every face sorted, then counted by runs (a map of 7 M faces took seconds at 1 M DoFs).

@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -24,6 +26,27 @@ double volume(const VolumeMesh& mesh) {
   for (Eigen::Index e = 0; e < mesh.num_tetrahedra(); ++e)
     sum += signed_tetrahedron_volume(mesh, e);
   return sum;
+}
+
+Eigen::VectorXd cell_quality(const VolumeMesh& mesh) {
+  Eigen::VectorXd quality(mesh.num_tetrahedra());
+  static constexpr int faces[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+  for (Eigen::Index e = 0; e < mesh.num_tetrahedra(); ++e) {
+    std::array<Eigen::Vector3d, 4> x;
+    for (int k = 0; k < 4; ++k)
+      x[std::size_t(k)] = mesh.vertices.row(mesh.tetrahedra(e, k)).transpose();
+    double area = 0.0, longest = 0.0;
+    for (const auto& f : faces)
+      area += 0.5 * (x[std::size_t(f[1])] - x[std::size_t(f[0])])
+                        .cross(x[std::size_t(f[2])] - x[std::size_t(f[0])])
+                        .norm();
+    for (std::size_t a = 0; a < 4; ++a)
+      for (std::size_t b = a + 1; b < 4; ++b)
+        longest = std::max(longest, (x[a] - x[b]).norm());
+    const double inradius = 3.0 * std::abs(signed_tetrahedron_volume(mesh, e)) / area;
+    quality[e] = area > 0.0 && longest > 0.0 ? 2.0 * std::sqrt(6.0) * inradius / longest : 0.0;
+  }
+  return quality;
 }
 
 Eigen::VectorXd lumped_vertex_masses(const VolumeMesh& mesh, double density) {

@@ -30,6 +30,11 @@ double volume(const VolumeMesh& mesh);
 /// weighs.
 Eigen::VectorXd lumped_vertex_masses(const VolumeMesh& mesh, double density);
 
+/// Shape quality of each tetrahedron: 2 sqrt(6) * inradius / longest edge, 1 for the regular
+/// tetrahedron and 0 for a flat one (a sliver). Scale-free. Iterative solvers feel the worst cells:
+/// the P2 brain needed twice the CG iterations with a worst cell of 0.001 than with one of 0.004.
+Eigen::VectorXd cell_quality(const VolumeMesh& mesh);
+
 /// Throws std::invalid_argument (one line naming the item) unless every tetrahedron refers to
 /// existing vertices and has positive volume.
 void check_volume_mesh(const VolumeMesh& mesh);
