@@ -78,7 +78,7 @@ struct Settings {
   double cell_size = 0.0;
   int level = 5;
   int algorithm = 1;
-  bool relocate = true;  ///< MeshOptions::relocate_interior_vertices
+  bool relocate = true;  ///< 0: MeshOptions::relocate_below_quality = 0 (never)
 };
 
 Settings parse(int argc, char** argv) {
@@ -155,7 +155,7 @@ int main(int argc, char** argv) {
     fem_reference::MeshOptions mesh_options;
     mesh_options.cell_size = settings.cell_size;
     mesh_options.algorithm_3d = settings.algorithm;
-    mesh_options.relocate_interior_vertices = settings.relocate;
+    if (!settings.relocate) mesh_options.relocate_below_quality = 0.0;
     mesh_options.refinements.push_back({setup.tool.contact_point, 2 * setup.tool.radius,
                                         2 * setup.tool.radius, 0.5 * settings.cell_size});
     const auto mesh_start = Clock::now();

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,16 +31,28 @@ GmshSession::~GmshSession() {
   gmsh::finalize();
 }
 
-VolumeMesh generate_tetrahedra(std::size_t num_kept_nodes, bool relocate_interior_vertices) {
+namespace {
+void run_gmsh(const std::function<void()>& step) {
   try {
-    gmsh::model::mesh::generate(3);
-    if (relocate_interior_vertices) gmsh::model::mesh::optimize("Relocate3D");
+    step();
   } catch (...) {
     std::string message;
     gmsh::logger::getLastError(message);
     throw FemError("Gmsh 3D meshing failed: " + (message.empty() ? "unknown error" : message));
   }
+}
+}  // namespace
 
+VolumeMesh generate_tetrahedra(std::size_t num_kept_nodes, double relocate_below_quality) {
+  run_gmsh([] { gmsh::model::mesh::generate(3); });
+  VolumeMesh mesh = current_tetrahedra(num_kept_nodes);
+  if (relocate_below_quality <= 0.0 || cell_quality(mesh).minCoeff() >= relocate_below_quality)
+    return mesh;
+  run_gmsh([] { gmsh::model::mesh::optimize("Relocate3D"); });
+  return current_tetrahedra(num_kept_nodes);
+}
+
+VolumeMesh current_tetrahedra(std::size_t num_kept_nodes) {
   std::vector<std::size_t> node_tags;
   std::vector<double> coordinates, parametric;
   gmsh::model::mesh::getNodes(node_tags, coordinates, parametric, -1, -1, true, false);

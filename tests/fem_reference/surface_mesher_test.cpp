@@ -129,9 +129,9 @@ TEST(SurfaceMesher, RelocationRaisesTheWorstCellOfTheFoldedBrain) {
   if (cases::signed_volume(brain) < 0.0) brain.triangles.col(1).swap(brain.triangles.col(2));
   MeshOptions options;
   options.cell_size = 0.003;
-  options.relocate_interior_vertices = false;
+  options.relocate_below_quality = 0.0;
   const VolumeMesh plain = mesh_closed_surface(brain.vertices, brain.triangles, options);
-  options.relocate_interior_vertices = true;
+  options.relocate_below_quality = 1.0;  // always
   const VolumeMesh relocated = mesh_closed_surface(brain.vertices, brain.triangles, options);
   EXPECT_EQ(relocated.num_tetrahedra(), plain.num_tetrahedra());
   EXPECT_EQ(relocated.vertices.topRows(brain.vertices.rows()), brain.vertices);

@@ -25,11 +25,13 @@ struct MeshOptions {
   /// Gmsh's Mesh.Algorithm3D: 1 = Delaunay (default: the same mesh on every run), 10 = HXT
   /// (several times faster on large meshes, but Gmsh 4.8's HXT differs from run to run).
   int algorithm_3d = 1;
-  /// After Gmsh's own optimisation, Gmsh's "Relocate3D" pass: interior vertices moved to raise the
-  /// quality of their worst tetrahedron. A folded surface (the brain's sulci) leaves slivers next
-  /// to it that the default pass keeps; on the 1.2 M-DoF brain at P2 the worst cell's quality rose
-  /// from 0.001 to 0.004 and CG needed 101 instead of 198 iterations (results/BENCHMARKS.md).
-  bool relocate_interior_vertices = true;
+  /// When the worst tetrahedron's quality (cell_quality) after Gmsh's own optimisation is below
+  /// this, Gmsh's "Relocate3D" pass moves interior vertices to raise it; 0 never. Large surface
+  /// triangles over a finer interior (the brain's) leave flat cells the default pass keeps: on the
+  /// 1.2 M-DoF brain at P2 the worst rose from 0.001 to 0.004 and CG needed 101 instead of 198
+  /// iterations (results/BENCHMARKS.md). Well-shaped meshes (a sphere's worst is 0.3) skip the
+  /// pass, which costs 8 s at 1.9 M cells.
+  double relocate_below_quality = 0.02;
 };
 
 /// Throws std::invalid_argument naming the first defect unless the triangles form a closed,
