@@ -353,7 +353,8 @@ void ElasticityProblem::Implementation::setup_system() {
                      off_diagonal_nonzeros);
   linear_system = std::make_unique<detail::PetscLinearSystem>(
       communicator, PetscInt(dof_handler.n_dofs()), PetscInt(first), PetscInt(owned.n_elements()),
-      diagonal_nonzeros, off_diagonal_nonzeros);
+      diagonal_nonzeros, off_diagonal_nonzeros,
+      two_level() ? detail::MatrixStorage::node_blocks : detail::MatrixStorage::scalar);
 
   statistics.dofs = dof_handler.n_dofs();
   statistics.cells = triangulation.n_active_cells();
@@ -480,9 +481,7 @@ void ElasticityProblem::Implementation::solve() {
     values.push_back(prescribed_value[i]);
   }
   linear_system->apply_prescribed_values(rows, values);
-  if (model.degree == 2 && model.solver.preconditioner == Preconditioner::gamg &&
-      model.solver.p_multigrid)
-    linear_system->set_coarse_space(p1_coarse_space());
+  if (two_level()) linear_system->set_coarse_space(p1_coarse_space());
   const detail::KrylovReport report = linear_system->solve(model.solver, coordinates);
   solution = linear_system->gathered_solution();
   linear_system.reset();

@@ -48,6 +48,11 @@ struct ElasticityProblem::Implementation {
   /// P2 only: the P1 space of the same mesh as the preconditioner's coarse level
   /// (coarse_space.cpp).
   detail::CoarseSpace p1_coarse_space() const;
+  /// P2 with CG + GAMG solves with the two-level preconditioner (SolverSettings::p_multigrid).
+  bool two_level() const {
+    return model.degree == 2 && model.solver.preconditioner == Preconditioner::gamg &&
+           model.solver.p_multigrid;
+  }
 
   MPI_Comm communicator;
   VolumeMesh mesh;

@@ -138,7 +138,15 @@ void two_level_preconditioner(MPI_Comm communicator, Mat fine, const CoarseSpace
   }
   MSFEM_PETSC(MatAssemblyBegin(t.interpolation, MAT_FINAL_ASSEMBLY));
   MSFEM_PETSC(MatAssemblyEnd(t.interpolation, MAT_FINAL_ASSEMBLY));
-  MSFEM_PETSC(MatPtAP(fine, t.interpolation, MAT_INITIAL_MATRIX, 2.0, &t.coarse));
+  // PETSc 3.18 forms P^T K P for scalar (AIJ) storage only: a block-stored K is copied for it.
+  PetscBool blocks = PETSC_FALSE;
+  MSFEM_PETSC(PetscObjectTypeCompareAny(PetscObject(fine), &blocks, MATSEQBAIJ, MATMPIBAIJ, ""));
+  Mat scalar_fine = fine;
+  if (blocks) MSFEM_PETSC(MatConvert(fine, MATAIJ, MAT_INITIAL_MATRIX, &scalar_fine));
+  const PetscErrorCode product =
+      MatPtAP(scalar_fine, t.interpolation, MAT_INITIAL_MATRIX, 2.0, &t.coarse);
+  if (blocks) MatDestroy(&scalar_fine);
+  MSFEM_PETSC(product);
   MSFEM_PETSC(MatSetOption(t.coarse, MAT_SYMMETRIC, PETSC_TRUE));
 
   set_rigid_body_modes(communicator, t.coarse, space.node_coordinates, t.coordinates,
@@ -244,16 +252,28 @@ void ensure_petsc_initialized() {
 PetscLinearSystem::PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows,
                                      PetscInt first_owned_row, PetscInt owned_rows,
                                      const std::vector<PetscInt>& diagonal_block_nonzeros,
-                                     const std::vector<PetscInt>& off_diagonal_block_nonzeros)
+                                     const std::vector<PetscInt>& off_diagonal_block_nonzeros,
+                                     MatrixStorage storage)
     : communicator_(communicator), first_owned_row_(first_owned_row), owned_rows_(owned_rows) {
   MSFEM_PETSC(MatCreate(communicator_, &matrix_));
   MSFEM_PETSC(MatSetSizes(matrix_, owned_rows, owned_rows, global_rows, global_rows));
-  MSFEM_PETSC(MatSetType(matrix_, MATAIJ));
+  MSFEM_PETSC(MatSetType(matrix_, storage == MatrixStorage::node_blocks ? MATBAIJ : MATAIJ));
   // Block size 3 before preallocation: GAMG aggregates nodes, not single DoFs.
   MSFEM_PETSC(MatSetBlockSize(matrix_, 3));
-  MSFEM_PETSC(MatSeqAIJSetPreallocation(matrix_, 0, diagonal_block_nonzeros.data()));
-  MSFEM_PETSC(MatMPIAIJSetPreallocation(matrix_, 0, diagonal_block_nonzeros.data(), 0,
-                                        off_diagonal_block_nonzeros.data()));
+  if (storage == MatrixStorage::node_blocks) {
+    // Counts per block row, in blocks: a node's first row divided by its three components.
+    std::vector<PetscInt> diagonal(std::size_t(owned_rows / 3)), off_diagonal(diagonal.size());
+    for (std::size_t node = 0; node < diagonal.size(); ++node) {
+      diagonal[node] = diagonal_block_nonzeros[3 * node] / 3;
+      off_diagonal[node] = off_diagonal_block_nonzeros[3 * node] / 3;
+    }
+    MSFEM_PETSC(MatXAIJSetPreallocation(matrix_, 3, diagonal.data(), off_diagonal.data(), nullptr,
+                                        nullptr));
+  } else {
+    MSFEM_PETSC(MatSeqAIJSetPreallocation(matrix_, 0, diagonal_block_nonzeros.data()));
+    MSFEM_PETSC(MatMPIAIJSetPreallocation(matrix_, 0, diagonal_block_nonzeros.data(), 0,
+                                          off_diagonal_block_nonzeros.data()));
+  }
   MSFEM_PETSC(MatSetOption(matrix_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   MSFEM_PETSC(MatCreateVecs(matrix_, &solution_, &rhs_));
   MSFEM_PETSC(VecSet(solution_, 0.0));

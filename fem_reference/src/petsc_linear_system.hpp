@@ -34,11 +34,19 @@ struct CoarseSpace {
   std::vector<double> node_coordinates;
 };
 
+/// How the stiffness matrix is stored. node_blocks (PETSc's BAIJ, 3x3 blocks of a node pair)
+/// stores one column index per block instead of per entry: the two-level P2 solve, bound by
+/// memory bandwidth, ran 1.4-1.6x faster (results/BENCHMARKS.md). GAMG and hypre need scalar
+/// (AIJ) storage, so the other methods keep it.
+enum class MatrixStorage { scalar, node_blocks };
+
 class PetscLinearSystem {
  public:
+  /// The nonzero counts are per row (a node's three rows have the same counts).
   PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows, PetscInt first_owned_row,
                     PetscInt owned_rows, const std::vector<PetscInt>& diagonal_block_nonzeros,
-                    const std::vector<PetscInt>& off_diagonal_block_nonzeros);
+                    const std::vector<PetscInt>& off_diagonal_block_nonzeros,
+                    MatrixStorage storage = MatrixStorage::scalar);
   ~PetscLinearSystem();
   PetscLinearSystem(const PetscLinearSystem&) = delete;
   PetscLinearSystem& operator=(const PetscLinearSystem&) = delete;

@@ -119,8 +119,7 @@ VolumeMesh mesh_closed_surface(const Eigen::MatrixX3d& vertices, const Eigen::Ma
         return target_size(options, global_size, Eigen::Vector3d(x, y, z));
       });
 
-  VolumeMesh mesh =
-      detail::generate_tetrahedra(node_tags.size(), options.relocate_below_quality);
+  VolumeMesh mesh = detail::generate_tetrahedra(node_tags.size(), options.relocate_below_quality);
   // Node-to-node comparison with the mass-spring surface needs the surface vertices untouched.
   if (mesh.vertices.topRows(vertices.rows()) != vertices)
     throw FemError("Gmsh moved a surface vertex while meshing the volume");
