@@ -64,9 +64,10 @@ struct LoadModels {
 };
 
 LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d& displacement,
-                          const Eigen::Vector3d& force) {
+                          const Eigen::Vector3d& force, const BuiltVariant& variant) {
   LoadErrors e;
   e.load = reference.load.label();
+  e.tool_patch_nodes = static_cast<int>(variant.tool_patch.size());
   // tet_edges on the FEM's tool-refined mesh has more surface nodes; the case's come first.
   const Eigen::Index n = reference.surface_displacement.rows();
   if (displacement.rows() < n)
@@ -104,7 +105,8 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadRefere
     // The tool was placed once by models_for(): solve as the model stands.
     const StaticSolution s = solve_variant_static(m.variants[i], m.x[i]);
     m.x[i] = s.x;
-    errors.push_back(errors_against(references[i], s.surface_displacement, s.tool_force));
+    errors.push_back(
+        errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i]));
   }
   return errors;
 }
@@ -140,14 +142,14 @@ LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference,
   set_tool_depth(variant, reference.tool);
   const StaticSolution s = solve_variant_static(variant, x);
   x = s.x;
-  return errors_against(reference, s.surface_displacement, s.tool_force);
+  return errors_against(reference, s.surface_displacement, s.tool_force, variant);
 }
 
 LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference) {
   set_tool_depth(variant, reference.tool);
   LinearisedStatics statics(*variant.model, {variant.model->network().stiffness});
   const auto s = statics.solve({1.0}, variant.tool_patch);
-  return errors_against(reference, s.surface_displacement, s.patch_force);
+  return errors_against(reference, s.surface_displacement, s.patch_force, variant);
 }
 
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
@@ -218,7 +220,8 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
     std::vector<LoadErrors> errors;
     for (std::size_t i = 0; i < references.size(); ++i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
-      errors.push_back(errors_against(references[i], s.surface_displacement, s.patch_force));
+      errors.push_back(
+          errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]));
     }
     return errors;
   };

@@ -172,6 +172,20 @@ VariantOnTest mean_on(const std::string& name, bool calibrated,
   return v;
 }
 
+// Below this many tool nodes the report warns (see LoadErrors::tool_patch_nodes).
+constexpr int min_tool_patch_nodes = 3;
+
+// "load (N nodes), ..." for every training or held-out load whose tool patch is that small.
+std::string loads_with_few_tool_nodes(const ErrorsOnLoads& errors) {
+  std::string list;
+  for (const auto* set : {&errors.train, &errors.test})
+    for (const LoadErrors& e : *set)
+      if (e.tool_patch_nodes < min_tool_patch_nodes)
+        list += (list.empty() ? "" : ", ") + e.load + " (" + std::to_string(e.tool_patch_nodes) +
+                (e.tool_patch_nodes == 1 ? " node)" : " nodes)");
+  return list;
+}
+
 }  // namespace
 
 CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
@@ -210,6 +224,13 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   };
   c.fit = calibrate(c.problem, c.mesh, c.variant, c.train, c.test, options);
   if (!c.fit.converged) c.notes.push_back("the optimiser did not converge: " + c.fit.stop_reason);
+  if (const std::string few = loads_with_few_tool_nodes(c.fit.before); !few.empty())
+    c.notes.push_back(
+        "the tool holds fewer than " + std::to_string(min_tool_patch_nodes) + " surface nodes of " +
+        c.variant + " at " + few +
+        ": such a patch's force grows about linearly with depth while the FEM's resolved contact "
+        "grows faster, so no stiffness fits every depth; only a surface fine enough under the "
+        "tool for the patch to grow with depth can follow it");
 
   // The calibrated case, as calibrated.prm will state it; re-solving it checks that the file
   // reproduces the fit, and gives the equilibrium the damping fit linearises about.

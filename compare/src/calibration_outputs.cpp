@@ -19,7 +19,8 @@ nlohmann::json errors_json(const std::vector<LoadErrors>& errors) {
                     {"rel_l2_error", e.rel_l2_error},
                     {"mean_error_over_max_disp", e.mean_error_over_max_disp},
                     {"reaction_force_rel_error", e.reaction_force_rel_error},
-                    {"reaction_force_N", {e.tool_force.x(), e.tool_force.y(), e.tool_force.z()}}});
+                    {"reaction_force_N", {e.tool_force.x(), e.tool_force.y(), e.tool_force.z()}},
+                    {"tool_patch_nodes", e.tool_patch_nodes}});
   return list;
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "msfem/cases/surface_generators.hpp"
 
 namespace msfem {
 namespace {
@@ -35,6 +36,25 @@ TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
           EXPECT_TRUE(e[key].is_number() && std::isfinite(e[key].get<double>()))
               << side << "/" << set << "/" << key;
   }
+  // The tool patch of the first training load (0,0,1 @ 4 mm, tool radius 1 cm), counted here: the
+  // icosphere's vertices inside the tool ball, whose centre is r - d outside the pressed vertex.
+  {
+    const cases::Surface sphere = cases::icosphere(2, 0.05);
+    Eigen::Index top = 0;
+    sphere.vertices.col(2).maxCoeff(&top);
+    const Eigen::Vector3d p = sphere.vertices.row(top).transpose();
+    const Eigen::Vector3d centre = p + p.normalized() * (0.01 - 0.004);
+    int inside = 0;
+    for (Eigen::Index v = 0; v < sphere.vertices.rows(); ++v)
+      inside += (sphere.vertices.row(v).transpose() - centre).norm() < 0.01;
+    for (const char* side : {"before", "after"})
+      EXPECT_EQ(j[side]["train"][0]["tool_patch_nodes"].get<int>(), inside) << side;
+    bool warned = false;
+    for (const auto& note : j["notes"])
+      warned =
+          warned || note.get<std::string>().find("fewer than 3 surface nodes") != std::string::npos;
+    if (inside < 3) EXPECT_TRUE(warned) << inside << " nodes and no note";
+  }
   EXPECT_LT(j["after"]["objective"].get<double>(), j["before"]["objective"].get<double>());
   ASSERT_EQ(j["coefficients"].size(), 3u);
   EXPECT_EQ(j["coefficients"][0]["group"], "tier1_edges");
@@ -53,8 +73,8 @@ TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
   for (const auto& v : summary["variants"]) {
     if (v["name"] != "three_tier") continue;
     for (const auto& c : j["coefficients"]) {
-      const double built = v["parameters"]["spring_groups"][c["group"].get<std::string>()]
-                            ["mean_stiffness_n_per_m"];
+      const double built =
+          v["parameters"]["spring_groups"][c["group"].get<std::string>()]["mean_stiffness_n_per_m"];
       EXPECT_NEAR(built / c["fitted_stiffness_N_per_m"].get<double>(), 1.0, 1e-6) << c["group"];
     }
   }

@@ -36,6 +36,10 @@ struct LoadErrors {
   double mean_error_over_max_disp = 0.0;
   double reaction_force_rel_error = 0.0;
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
+  /// Surface nodes the tool holds in the spring model at this load. One node's force grows about
+  /// linearly with depth while the FEM's resolved contact grows faster: no stiffness fits every
+  /// depth then (results/BENCHMARKS.md, issue E, session 6).
+  int tool_patch_nodes = 0;
 };
 
 struct ErrorsOnLoads {
