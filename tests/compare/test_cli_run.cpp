@@ -79,6 +79,10 @@ TEST_F(RunSmallSphere, SummaryHasTheDocumentedSchemaAndFiniteNumbers) {
   for (const char* key :
        {"degree", "dofs", "cells", "solve_time_s", "iterations", "reaction_force_N"})
     EXPECT_TRUE(j["fem"].contains(key)) << key;
+  // A tetrahedron's quality lies in (0, 1]; Gmsh's mesh of the small sphere is far from flat.
+  const double worst = j["fem"]["worst_cell_quality"].get<double>();
+  EXPECT_GT(worst, 0.05);
+  EXPECT_LE(worst, 1.0);
   ASSERT_EQ(j["variants"].size(), 4u);
   for (const auto& v : j["variants"]) {
     for (const char* key : kVariantKeys)
