@@ -9,6 +9,7 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/fem_cache.hpp"
+#include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -279,6 +280,8 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       store_fem_cache(*settings.fem_cache_directory, run.fem_cache_key,
                       {run.mesh, run.fem, run.fem_force_depth, other_fem});
   }
+  if (run.mesh.num_tetrahedra() > 0)
+    run.worst_cell_quality = fem_reference::cell_quality(run.mesh).minCoeff();
   for (int t = 1; t <= other_tools; ++t) {
     ToolLoad load;
     load.tool = t;

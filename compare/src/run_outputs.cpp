@@ -5,22 +5,14 @@
 
 #include <cstdio>
 #include <sstream>
-#include <string>
 
 #include "msfem/compare/atomic_file.hpp"
 #include "msfem/compare/plots.hpp"
 #include "msfem/compare/result_writers.hpp"
 #include "msfem/fem_reference/elasticity_problem.hpp"
-#include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
 namespace {
-
-std::string fmt_quality(double quality) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", quality);
-  return text;
-}
 
 void write_surfaces(const CaseRun& run, const std::filesystem::path& dir) {
   const auto& s = run.problem.surface;
@@ -149,12 +141,9 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
      << " kg/m³\n"
      << "- FEM: P" << p.fem.degree << ", " << run.fem.statistics.dofs << " dofs, "
      << run.fem.statistics.cells << " cells, " << run.fem.statistics.iterations << " iterations, "
-     << run.fem.statistics.solve_time_s << " s solve"
-     << (run.mesh.num_tetrahedra() > 0
-             ? ", worst cell quality " +
-                   fmt_quality(fem_reference::cell_quality(run.mesh).minCoeff())
-             : std::string())
-     << "\n"
+     << run.fem.statistics.solve_time_s << " s solve";
+  if (run.worst_cell_quality) md << ", worst cell quality " << *run.worst_cell_quality;
+  md << "\n"
      << "- errors over " << run.compared_vertices.size()
      << " surface vertices not prescribed by a support or the tool\n"
      << "- FEM result " << (run.fem_from_cache ? "reused from the cache" : "computed") << " (key "

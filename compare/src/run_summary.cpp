@@ -9,7 +9,6 @@
 #include <thread>
 
 #include "msfem/compare/run_outputs.hpp"
-#include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -106,14 +105,6 @@ std::string machine_description() {
          std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
-namespace {
-// The FEM mesh's worst tetrahedron (fem_reference::cell_quality): CG's iterations follow it.
-nlohmann::json worst_cell_quality(const fem_reference::VolumeMesh& mesh) {
-  if (mesh.num_tetrahedra() == 0) return nullptr;
-  return fem_reference::cell_quality(mesh).minCoeff();
-}
-}  // namespace
-
 nlohmann::json summary_json(const CaseRun& run) {
   const auto& p = run.problem.parameters;
   const auto& st = run.fem.statistics;
@@ -128,7 +119,7 @@ nlohmann::json summary_json(const CaseRun& run) {
                         {"mpi_ranks", st.mpi_ranks},
                         {"reaction_force_N", vec(run.fem.tool_force)},
                         {"volume_change", run.fem.volume_change},
-                        {"worst_cell_quality", worst_cell_quality(run.mesh)},
+                        {"worst_cell_quality", optional_json(run.worst_cell_quality)},
                         {"cache_key", run.fem_cache_key},
                         {"from_cache", run.fem_from_cache}};
   nlohmann::json curve = nlohmann::json::array();

@@ -129,8 +129,7 @@ VolumeMesh mesh_closed_surface(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   std::vector<std::array<int, 3>> faces;
   faces.reserve(4 * std::size_t(mesh.num_tetrahedra()));
   for (Eigen::Index e = 0; e < mesh.num_tetrahedra(); ++e) {
-    static constexpr int face_vertices[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
-    for (const auto& f : face_vertices) {
+    for (const auto& f : tetrahedron_faces) {
       std::array<int, 3> key{
           {mesh.tetrahedra(e, f[0]), mesh.tetrahedra(e, f[1]), mesh.tetrahedra(e, f[2])}};
       std::sort(key.begin(), key.end());

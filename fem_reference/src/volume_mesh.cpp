@@ -30,13 +30,12 @@ double volume(const VolumeMesh& mesh) {
 
 Eigen::VectorXd cell_quality(const VolumeMesh& mesh) {
   Eigen::VectorXd quality(mesh.num_tetrahedra());
-  static constexpr int faces[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
   for (Eigen::Index e = 0; e < mesh.num_tetrahedra(); ++e) {
     std::array<Eigen::Vector3d, 4> x;
     for (int k = 0; k < 4; ++k)
       x[std::size_t(k)] = mesh.vertices.row(mesh.tetrahedra(e, k)).transpose();
     double area = 0.0, longest = 0.0;
-    for (const auto& f : faces)
+    for (const auto& f : tetrahedron_faces)
       area += 0.5 * (x[std::size_t(f[1])] - x[std::size_t(f[0])])
                         .cross(x[std::size_t(f[2])] - x[std::size_t(f[0])])
                         .norm();

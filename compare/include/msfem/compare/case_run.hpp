@@ -74,6 +74,8 @@ struct ToolLoad {
 struct CaseRun {
   Problem problem;
   fem_reference::VolumeMesh mesh;
+  /// The mesh's worst tetrahedron (fem_reference::cell_quality): CG's iterations follow it.
+  std::optional<double> worst_cell_quality;
   FemSolution fem;
   std::vector<ForceDepthPoint> fem_force_depth;
   std::optional<bool> fem_force_depth_monotone;

@@ -22,6 +22,9 @@ struct VolumeMesh {
   Eigen::Index num_tetrahedra() const { return tetrahedra.rows(); }
 };
 
+/// The four faces of a tetrahedron as local vertex triples (each face omits one vertex).
+inline constexpr int tetrahedron_faces[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+
 /// Sum of the tetrahedra's volumes.
 double volume(const VolumeMesh& mesh);
 
