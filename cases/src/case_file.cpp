@@ -75,8 +75,9 @@ void declare_loads(ParameterHandler& prm) {
   prm.enter_subsection("tool");
   prm.declare_entry("enabled", "true", Patterns::Bool(), "Press a rigid spherical tool.");
   prm.declare_entry("mode", "prescribed", Patterns::Selection("prescribed|contact"),
-                    "prescribed: the contact patch moves with the tool; contact: frictionless "
-                    "contact, nodes inside the sphere are projected onto it.");
+                    "prescribed: the contact patch moves with the tool. contact (frictionless "
+                    "contact) is reserved: msfem run, sweep and calibrate refuse it until the FEM "
+                    "reference can press a tool by contact.");
   prm.declare_entry(
       "directions", "0,0,1", Patterns::List(point_pattern(), 1, Patterns::List::max_int_value, ";"),
       "Where the tool presses, one indentation per entry (';'-separated): the surface "

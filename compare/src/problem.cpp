@@ -131,6 +131,13 @@ Problem make_problem(const cases::CaseParameters& parameters) {
                             ": support: the fixed region contains the whole surface");
 
   if (parameters.loads.tool.enabled) {
+    // Both models press the tool as a prescribed patch; reading `contact` and doing that anyway
+    // would compare something other than what the case asks for.
+    if (parameters.loads.tool.mode == cases::ToolParameters::Mode::contact)
+      throw cases::InputError(
+          parameters.file.string() +
+          ": loads/tool/mode = contact: frictionless tool contact is not implemented in the FEM "
+          "reference, so the two models could not be compared under it; use mode = prescribed");
     const Eigen::MatrixX3d normals = cases::vertex_normals(s);
     for (const auto& d : parameters.loads.tool.directions) {
       ToolPlacement t = place_tool(parameters, s, normals, problem.centroid, d);

@@ -164,6 +164,9 @@ TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
                                           "  set half space point = 0,0,0.04\n"
                                           "  set half space normal = 0,0,1\nend\n"),
        "fixed node"},
+      {write_case("contact.prm", base + "subsection loads\n  subsection tool\n"
+                                        "    set mode = contact\n  end\nend\n"),
+       "loads/tool/mode = contact"},
       {(tmp / "absent.prm").string(), "absent.prm"},
   };
   for (const auto& [file, named] : cases) {
