@@ -114,7 +114,13 @@ void declare_mass_spring(ParameterHandler& prm) {
   prm.declare_entry("damping ratio", "0.5", Patterns::Double(0),
                     "Spring dampers as a fraction of critical damping.");
   prm.declare_entry("group scales", "", Patterns::List(Patterns::Anything()),
-                    "Per spring group stiffness factors, GROUP:FACTOR, e.g. tier1_edges:1.5.");
+                    "Per spring group stiffness factors, GROUP:FACTOR, e.g. tier1_edges:1.5 "
+                    "(volume:FACTOR scales the volume preservation modulus).");
+  prm.declare_entry("volume preservation", "false", Patterns::Bool(),
+                    "Add the energy 1/2 k (V - V0)^2 / |V0| of every shell prism (three_tier) and "
+                    "tetrahedron (tet_edges), k = lambda(E, nu) - lambda(E, 1/4): the bulk "
+                    "stiffness a network of central springs lacks (its Poisson's ratio is 1/4). "
+                    "msfem calibrate can fit it as the group 'volume'.");
   prm.enter_subsection("three tier");
   prm.declare_entry("middle tier scale", "1.2", Patterns::Double(1.0),
                     "Tier 2 is the surface scaled by 1/scale about its centroid.");
@@ -339,6 +345,7 @@ CaseParameters extract(ParameterHandler& prm) {
                        "' is not GROUP:FACTOR with a positive factor");
     ms.group_scales.emplace_back(entry.substr(0, colon), factor);
   }
+  ms.volume_preservation = prm.get_bool("volume preservation");
   prm.enter_subsection("three tier");
   ms.middle_tier_scale = prm.get_double("middle tier scale");
   ms.inner_tier_scale = prm.get_double("inner tier scale");

@@ -98,10 +98,12 @@ LoadModels models_for(const BuiltVariant& base, const std::vector<LoadReference>
 }
 
 std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadReference>& references,
-                                     const Eigen::VectorXd& stiffness) {
+                                     const Eigen::VectorXd& stiffness,
+                                     const Eigen::VectorXd& volume_modulus) {
   std::vector<LoadErrors> errors;
   for (std::size_t i = 0; i < references.size(); ++i) {
     m.variants[i].model->set_stiffness(stiffness);
+    if (auto& volume = m.variants[i].model->volume()) volume->set_modulus(volume_modulus);
     // The tool was placed once by models_for(): solve as the model stands.
     const StaticSolution s = solve_variant_static(m.variants[i], m.x[i]);
     m.x[i] = s.x;
@@ -148,7 +150,7 @@ LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference,
 LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference) {
   set_tool_depth(variant, reference.tool);
   LinearisedStatics statics(*variant.model, {variant.model->network().stiffness});
-  const auto s = statics.solve({1.0}, variant.tool_patch);
+  const auto s = statics.solve(std::vector<double>(statics.num_parts(), 1.0), variant.tool_patch);
   return errors_against(reference, s.surface_displacement, s.patch_force, variant);
 }
 
@@ -164,15 +166,22 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                             "calibration/train loads)");
   const BuiltVariant base = build_variant(variant_name, problem, mesh, train.front().tool);
   const auto& network = base.model->network();
+  // The fittable groups: the spring groups, and the volume modulus when the variant has one.
+  std::vector<std::string> fittable = network.spring_group_names;
+  if (base.model->volume()) fittable.push_back(volume_group);
   std::vector<std::string> groups = options.groups;
-  if (groups.empty()) groups = network.spring_group_names;
+  if (groups.empty()) groups = fittable;
   std::string known;
-  for (const auto& g : network.spring_group_names)
+  for (const auto& g : fittable)
     known += (known.empty() ? "" : ", ") + g;
   for (const auto& g : groups)
-    if (std::count(network.spring_group_names.begin(), network.spring_group_names.end(), g) != 1)
-      throw cases::InputError(file + ": calibration: variant " + variant_name +
-                              " has no spring group '" + g + "' (its groups: " + known + ")");
+    if (std::count(fittable.begin(), fittable.end(), g) != 1)
+      throw cases::InputError(
+          file + ": calibration: variant " + variant_name + " has no group '" + g +
+          "' (its groups: " + known +
+          (g == volume_group ? "; the volume group needs mass spring/volume preservation = true"
+                             : "") +
+          ")");
   for (std::size_t i = 0; i < groups.size(); ++i)
     if (std::count(groups.begin(), groups.end(), groups[i]) > 1)
       throw cases::InputError(file + ": calibration: group '" + groups[i] + "' is listed twice");
@@ -180,9 +189,24 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
     throw std::invalid_argument("calibrate: one start factor per fitted group is needed");
 
   const int n = static_cast<int>(groups.size());
-  std::vector<int> group_id(n);
-  for (int g = 0; g < n; ++g)
-    group_id[g] = network.spring_group_id(groups[g]);
+  // Spring group id of each fitted group; -1 for the volume group, at index `volume_index`.
+  std::vector<int> group_id(n, -1);
+  int volume_index = -1;
+  for (int g = 0; g < n; ++g) {
+    if (groups[g] == volume_group)
+      volume_index = g;
+    else
+      group_id[g] = network.spring_group_id(groups[g]);
+  }
+  const Eigen::VectorXd case_modulus =
+      base.model->volume() ? base.model->volume()->elements().modulus : Eigen::VectorXd();
+  const double volume_start_factor = volume_index >= 0 && !options.start_factors.empty()
+                                         ? options.start_factors[volume_index]
+                                         : 1.0;
+  auto modulus_at = [&](const std::vector<double>& theta) {
+    return Eigen::VectorXd(case_modulus * volume_start_factor *
+                           (volume_index >= 0 ? std::exp(theta[volume_index]) : 1.0));
+  };
   // The case's stiffness (analytic × its group scales) and the start (× the start factors).
   const Eigen::VectorXd case_stiffness = network.stiffness;
   Eigen::VectorXd start_stiffness = case_stiffness;
@@ -213,10 +237,14 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   }
   auto evaluate = [&](LoadModels& m, const std::vector<LoadReference>& references,
                       const std::vector<double>& theta) {
-    if (!options.linear) return evaluate_all(m, references, stiffness_at(theta));
+    if (!options.linear) return evaluate_all(m, references, stiffness_at(theta), modulus_at(theta));
+    // Parts: the unfitted springs, each fitted spring group, and the volume (LinearisedStatics
+    // puts it last); the volume group's own part stays empty.
     std::vector<double> weights(n + 1, 1.0);
     for (int g = 0; g < n; ++g)
       weights[g + 1] = std::exp(theta[g]);
+    if (base.model->volume())
+      weights.push_back(modulus_at(theta).sum() / std::max(case_modulus.sum(), 1e-300));
     std::vector<LoadErrors> errors;
     for (std::size_t i = 0; i < references.size(); ++i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
@@ -283,7 +311,14 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
     FittedGroup f;
     f.group = groups[g];
     double k_start = 0, k_case = 0, k_fit = 0;
-    for (int s = 0; s < network.num_springs(); ++s)
+    if (g == volume_index) {
+      f.unit = "Pa";
+      f.springs = static_cast<int>(case_modulus.size());
+      k_case = case_modulus.sum();
+      k_start = k_case * volume_start_factor;
+      k_fit = modulus_at(best_theta).sum();
+    }
+    for (int s = 0; s < network.num_springs() && g != volume_index; ++s)
       if (network.spring_group[s] == group_id[g]) {
         ++f.springs;
         k_start += start_stiffness[s];

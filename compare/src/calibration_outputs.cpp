@@ -62,12 +62,13 @@ std::string loads_table(const CaseCalibration& c) {
 
 std::string coefficients_table(const CaseCalibration& c) {
   std::ostringstream t;
-  t << "| group | springs | start k (N/m, mean) | fitted k (N/m, mean) | factor | group scale to "
-       "write |\n|---|---|---|---|---|---|\n";
+  // The volume group's "stiffness" is its modulus κ in Pa, over volume elements, not springs.
+  t << "| group | springs (elements) | start (mean) | fitted (mean) | unit | factor | group scale "
+       "to write |\n|---|---|---|---|---|---|---|\n";
   for (const auto& g : c.fit.groups)
     t << "| " << g.group << " | " << g.springs << " | " << fmt("%.5g", g.start_stiffness_n_per_m)
-      << " | " << fmt("%.5g", g.fitted_stiffness_n_per_m) << " | " << fmt("%.4f", g.factor) << " | "
-      << fmt("%.6g", g.case_factor) << " |\n";
+      << " | " << fmt("%.5g", g.fitted_stiffness_n_per_m) << " | " << g.unit << " | "
+      << fmt("%.4f", g.factor) << " | " << fmt("%.6g", g.case_factor) << " |\n";
   return t.str();
 }
 
@@ -144,13 +145,20 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
 
 nlohmann::json calibration_json(const CaseCalibration& c) {
   nlohmann::json coefficients = nlohmann::json::array();
-  for (const auto& g : c.fit.groups)
-    coefficients.push_back({{"group", g.group},
-                            {"springs", g.springs},
-                            {"start_stiffness_N_per_m", g.start_stiffness_n_per_m},
-                            {"fitted_stiffness_N_per_m", g.fitted_stiffness_n_per_m},
-                            {"factor", g.factor},
-                            {"group_scale", g.case_factor}});
+  for (const auto& g : c.fit.groups) {
+    nlohmann::json entry = {
+        {"group", g.group}, {"unit", g.unit}, {"factor", g.factor}, {"group_scale", g.case_factor}};
+    if (g.unit == "Pa") {  // the volume group: elements and the modulus κ
+      entry["elements"] = g.springs;
+      entry["start_modulus_Pa"] = g.start_stiffness_n_per_m;
+      entry["fitted_modulus_Pa"] = g.fitted_stiffness_n_per_m;
+    } else {
+      entry["springs"] = g.springs;
+      entry["start_stiffness_N_per_m"] = g.start_stiffness_n_per_m;
+      entry["fitted_stiffness_N_per_m"] = g.fitted_stiffness_n_per_m;
+    }
+    coefficients.push_back(entry);
+  }
   nlohmann::json variants = nlohmann::json::array();
   for (const auto& v : c.variants)
     variants.push_back({{"name", v.name},

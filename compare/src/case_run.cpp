@@ -35,10 +35,14 @@ nlohmann::json variant_parameters(const massspring::MassSpringModel& model) {
                                        {"mean_stiffness_n_per_m", count ? k / count : 0.0},
                                        {"mean_damping_n_s_per_m", count ? d / count : 0.0}};
   }
-  return {{"spring_groups", groups},
-          {"total_mass_kg", n.masses.sum()},
-          {"anchors", n.num_anchors()},
-          {"constrained_nodes", model.constrained_nodes().size()}};
+  nlohmann::json parameters = {{"spring_groups", groups},
+                               {"total_mass_kg", n.masses.sum()},
+                               {"anchors", n.num_anchors()},
+                               {"constrained_nodes", model.constrained_nodes().size()}};
+  if (const auto& volume = model.volume())
+    parameters["volume_preservation"] = {{"elements", volume->elements().num_elements()},
+                                         {"mean_modulus_pa", volume->elements().modulus.mean()}};
+  return parameters;
 }
 
 std::string millimetres(double metres) {

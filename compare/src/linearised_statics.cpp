@@ -11,10 +11,14 @@ LinearisedStatics::LinearisedStatics(const ms::MassSpringModel& model,
     : model_(model) {
   const int n = model.num_dofs();
   const Eigen::VectorXd rest = model.rest_state();
-  for (std::size_t p = 0; p < parts.size(); ++p) {
+  const bool volume = model.volume().has_value();
+  for (std::size_t p = 0; p < parts.size() + (volume ? 1 : 0); ++p) {
     ms::MassSpringModel part = model;
-    part.set_stiffness(parts[p]);
+    const bool volume_part = p == parts.size();
+    part.set_stiffness(volume_part ? Eigen::VectorXd::Zero(model.network().num_springs())
+                                   : parts[p]);
     if (p > 0 && part.network().num_anchors() > 0) part.set_anchor_parameters(0.0, 0.0);
+    if (!volume_part) part.clear_volume();
     ms::Triplets t;
     part.add_dfdx_triplets(rest, Eigen::VectorXd::Zero(n), t, ms::Linearisation::exact);
     Eigen::SparseMatrix<double> j(n, n);

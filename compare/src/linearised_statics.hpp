@@ -18,9 +18,13 @@ class LinearisedStatics {
  public:
   /// `parts[p]` is a per-spring stiffness vector (zero outside the part; anchors, if any, belong to
   /// part 0, whose weight should stay 1); the model's constraints
-  /// (supports and the tool's prescribed patch) and loads are those of `model`.
+  /// (supports and the tool's prescribed patch) and loads are those of `model`. A model with
+  /// volume preservation gets one more part, last, holding the volume stiffness alone.
   LinearisedStatics(const massspring::MassSpringModel& model,
                     const std::vector<Eigen::VectorXd>& parts);
+
+  /// The number of weights solve() takes: the parts, plus one for the volume if the model has it.
+  int num_parts() const { return static_cast<int>(jacobians_.size()); }
 
   struct Solution {
     Eigen::MatrixX3d surface_displacement;                  ///< in surface vertex order, m

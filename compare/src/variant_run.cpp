@@ -105,6 +105,25 @@ void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
     model.set_external_force(surface_nodes[v], patch.force_n * areas[v] / total_area);
 }
 
+// The volume elements of a variant that has them (three_tier's shell prisms, tet_edges'
+// tetrahedra), κ = λ(E, ν) − λ(E, 1/4) times the case's `volume` group scale.
+void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
+  const auto& p = problem.parameters;
+  ms::MassSpringModel& model = *variant.model;
+  double modulus = ms::volume_modulus_for(p.material.youngs_modulus_pa, p.material.poisson_ratio);
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (group == volume_group) modulus *= factor;
+  const auto& rest = model.network().rest_positions;
+  if (variant.name == "three_tier")
+    model.set_volume(ms::VolumeForceField(
+        model.num_nodes(),
+        ms::tier_prisms(rest, problem.surface.triangles,
+                        static_cast<int>(problem.surface.num_vertices()), 3, modulus)));
+  else if (variant.name == "tet_edges")
+    model.set_volume(ms::VolumeForceField(
+        model.num_nodes(), ms::tetrahedron_elements(rest, variant.tetrahedra, modulus)));
+}
+
 }  // namespace
 
 const std::vector<std::string>& known_variants() {
@@ -172,6 +191,7 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
         continue;  // a group of another variant
       model.scale_group_stiffness(group, factor);
     }
+    if (p.mass_spring.volume_preservation) set_volume_preservation(variant, problem);
     if (model.constrained_nodes().empty() && model.network().num_anchors() == 0)
       throw cases::InputError(p.file.string() + ": variant " + name +
                               ": no node lies in the fixed region and nothing anchors it, so it "
@@ -235,8 +255,9 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
   t.dt_s = timing.dt_s > 0 ? timing.dt_s : 0.5 * t.stable_dt_s;
 
   // The real-time path: the fast stepper for symplectic Euler (it has no tool contact, but the
-  // prescribed patch is a support it honours); the generic integrator otherwise.
-  const bool fast = kind == ms::IntegratorKind::symplectic_euler;
+  // prescribed patch is a support it honours); the generic integrator otherwise, and for volume
+  // preservation, which the fast kernels do not have.
+  const bool fast = kind == ms::IntegratorKind::symplectic_euler && !model.volume();
   std::unique_ptr<ms::FastExplicitStepper> stepper;
   ms::Integrator integrator(kind);
   ms::State state = start;

@@ -257,6 +257,12 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 
 FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
                                          const FastImplicitOptions& options) {
+  // Its kernels know springs, anchors, gravity and loads only: dropping a force field silently
+  // would step another model than the one given.
+  if (model.volume() || model.contact())
+    throw ModelError(
+        "fast implicit stepper: the model has volume preservation or tool contact, "
+        "which its kernels do not step; use Integrator");
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
   if (options.single_precision &&
       detail::preferred_lanes<float>(true, model.network().num_springs(), model.num_nodes()) == 16)

@@ -158,12 +158,20 @@ void MassSpringModel::set_contact(const SphereContactForceField& contact) {
   contact_ = contact;
 }
 
+void MassSpringModel::set_volume(const VolumeForceField& volume) {
+  if (volume.num_dofs() != num_dofs())
+    throw ModelError("volume elements: built for " + std::to_string(volume.num_dofs() / 3) +
+                     " nodes, model has " + std::to_string(num_nodes()));
+  volume_ = volume;
+}
+
 void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                 Eigen::VectorXd& f) const {
   springs().add_force(x, v, f);
   for (int i = 0; i < num_nodes(); ++i)
     f.segment<3>(3 * i) += network_.masses[i] * gravity_ + external_force_.row(i).transpose();
   if (contact_) contact_->add_force(x, v, f);
+  if (volume_) volume_->add_force(x, v, f);
 }
 
 double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
@@ -173,6 +181,7 @@ double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
     energy -= (network_.masses[i] * gravity_ + external_force_.row(i).transpose())
                   .dot(x.segment<3>(3 * i));
   if (contact_) energy += contact_->potential_energy(x);
+  if (volume_) energy += volume_->potential_energy(x);
   return energy;
 }
 
@@ -181,6 +190,7 @@ void MassSpringModel::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::Ve
                                        Linearisation mode) const {
   springs().add_dfdx_product(x, v, dx, df, mode);
   if (contact_) contact_->add_dfdx_product(x, v, dx, df, mode);
+  if (volume_) volume_->add_dfdx_product(x, v, dx, df, mode);
 }
 
 void MassSpringModel::add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
@@ -192,6 +202,7 @@ void MassSpringModel::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::V
                                         Triplets& triplets, Linearisation mode) const {
   springs().add_dfdx_triplets(x, v, triplets, mode);
   if (contact_) contact_->add_dfdx_triplets(x, v, triplets, mode);
+  if (volume_) volume_->add_dfdx_triplets(x, v, triplets, mode);
 }
 
 void MassSpringModel::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const {

@@ -38,6 +38,15 @@ NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
   if (model.contact())
     for (int i : model.contact()->nodes())
       in_contact_set_[i] = 1;
+  // A volume element's energy couples all its nodes, so it is not local to any of them: those
+  // nodes are left to Newton.
+  in_volume_element_.assign(net.num_nodes(), 0);
+  if (model.volume()) {
+    const Eigen::MatrixX4i& tets = model.volume()->elements().tets;
+    for (Eigen::Index t = 0; t < tets.rows(); ++t)
+      for (int e = 0; e < 4; ++e)
+        in_volume_element_[tets(t, e)] = 1;
+  }
 }
 
 double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vector3d& p,
@@ -112,7 +121,7 @@ int NodeRelaxation::relax(Eigen::VectorXd& x, const Eigen::VectorXd& f, double f
     largest = std::max(largest, f.segment<3>(3 * i).norm());
   std::vector<int> nodes;
   for (int i = 0; i < model_.num_nodes(); ++i)
-    if (!model_.is_constrained(i) && largest > 0.0 &&
+    if (!model_.is_constrained(i) && !in_volume_element_[i] && largest > 0.0 &&
         f.segment<3>(3 * i).norm() >= fraction * largest)
       nodes.push_back(i);
   for (int sweep = 0; sweep < sweeps; ++sweep)

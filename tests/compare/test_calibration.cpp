@@ -87,6 +87,54 @@ TEST(Calibration, RecoversKnownCoefficientsFromAStartTwoToThreeTimesOff) {
   EXPECT_EQ(fit.history.size(), static_cast<std::size_t>(fit.evaluations));
 }
 
+TEST(Calibration, RecoversTheVolumeModulusWithTheSprings) {
+  // ν = 0.45: volume preservation adds κ = λ(E, 0.45) − λ(E, 1/4) ≈ 2.7 E to every shell prism.
+  const std::vector<std::string> groups = {"tier1_edges", "tier12_radial", "volume"};
+  const std::vector<double> truth = {1.3, 0.9, 0.6};
+  const std::vector<double> start_off = {2.5, 1.0 / 3.0, 2.0};
+  cases::CaseParameters p = sphere_case();
+  p.material.poisson_ratio = 0.45;
+  p.mass_spring.volume_preservation = true;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    p.mass_spring.group_scales.emplace_back(groups[g], truth[g]);
+  const std::vector<LoadReference> refs = synthetic_references(make_problem(p));
+  p.mass_spring.group_scales.clear();
+  const Problem problem = make_problem(p);
+  CalibrationOptions options;
+  options.groups = groups;
+  options.tolerance = 1e-7;
+  options.max_evaluations = 2000;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    options.start_factors.push_back(truth[g] * start_off[g]);
+  const std::vector<LoadReference> train(refs.begin(), refs.begin() + 2);
+  const std::vector<LoadReference> test(refs.begin() + 2, refs.end());
+  const CalibrationFit fit = calibrate(problem, {}, "three_tier", train, test, options);
+  ASSERT_EQ(fit.groups.size(), groups.size());
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    EXPECT_NEAR(fit.groups[g].case_factor / truth[g], 1.0, 0.01) << groups[g];
+  EXPECT_EQ(fit.groups[2].unit, "Pa");
+  EXPECT_EQ(fit.groups[2].springs, 2 * problem.surface.triangles.rows());  // prisms, two shells
+  const double kappa = 3000.0 * (0.45 / (1.45 * 0.1) - 0.25 / (1.25 * 0.5));
+  EXPECT_NEAR(fit.groups[2].fitted_stiffness_n_per_m / (truth[2] * kappa), 1.0, 0.01);
+  EXPECT_GT(fit.before.test[0].rel_l2_error, 0.05);
+  EXPECT_LT(fit.after.test[0].rel_l2_error, 1e-3);
+  EXPECT_LT(fit.after.test[0].reaction_force_rel_error, 1e-3);
+}
+
+TEST(Calibration, TheVolumeGroupNeedsVolumePreservation) {
+  const Problem problem = make_problem(sphere_case());
+  const auto refs = synthetic_references(problem);
+  CalibrationOptions options;
+  options.groups = {"volume"};
+  try {
+    calibrate(problem, {}, "three_tier", refs, {}, options);
+    FAIL() << "the volume group was accepted without volume preservation";
+  } catch (const cases::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("volume preservation = true"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Calibration, RejectsUnknownGroupsAndAnEmptyTrainingSet) {
   const Problem problem = make_problem(sphere_case());
   const auto refs = synthetic_references(problem);
@@ -220,6 +268,37 @@ TEST(Calibration, LinearisedModelAgreesWithNewtonAtSmallDepth) {
   // Fitting the linearised model to (nearly linear) data recovers the scales to about 1 %.
   EXPECT_NEAR(linear.groups[0].case_factor, 1.5, 0.03);
   EXPECT_NEAR(linear.groups[1].case_factor, 0.6, 0.012);
+}
+
+TEST(Calibration, LinearisedVolumeStiffnessAgreesWithNewtonAndIsFitted) {
+  cases::CaseParameters p = sphere_case();
+  p.support.kind = cases::SupportParameters::Kind::half_space;
+  p.support.half_space_point = Eigen::Vector3d(0, 0, -0.02);
+  p.support.half_space_normal = -Eigen::Vector3d::UnitZ();
+  p.loads.tool.depth_m = 0.00005;
+  p.loads.tool.directions = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
+  p.material.poisson_ratio = 0.45;
+  p.mass_spring.volume_preservation = true;
+  p.mass_spring.group_scales = {{"tier1_edges", 1.5}, {"volume", 0.5}};
+  const std::vector<LoadReference> refs = synthetic_references(make_problem(p), {5e-5, 5e-5});
+  p.mass_spring.group_scales.clear();
+  const Problem problem = make_problem(p);
+  CalibrationOptions options;
+  options.groups = {"tier1_edges", "volume"};
+  options.max_evaluations = 1;
+  const CalibrationFit newton = calibrate(problem, {}, "three_tier", refs, {}, options);
+  options.linear = true;
+  options.max_evaluations = 200;
+  options.tolerance = 1e-6;
+  const CalibrationFit linear = calibrate(problem, {}, "three_tier", refs, {}, options);
+  for (std::size_t i = 0; i < refs.size(); ++i) {
+    EXPECT_GT(newton.before.train[i].rel_l2_error, 0.02);
+    EXPECT_NEAR(linear.before.train[i].rel_l2_error, newton.before.train[i].rel_l2_error, 0.005);
+    EXPECT_NEAR(linear.before.train[i].reaction_force_rel_error,
+                newton.before.train[i].reaction_force_rel_error, 0.005);
+  }
+  EXPECT_NEAR(linear.groups[0].case_factor, 1.5, 0.03);
+  EXPECT_NEAR(linear.groups[1].case_factor, 0.5, 0.01);
 }
 
 }  // namespace

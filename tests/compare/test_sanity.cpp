@@ -4,6 +4,7 @@
 // - the FEM's and the spring models' reaction forces grow with the tool's depth.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -56,6 +57,42 @@ TEST(Sanity, TetEdgesIsCloserThanSingleLayerAtNuQuarterOnEverySweepResolution) {
     EXPECT_LT(by_variant.at("tet_edges"), by_variant.at("single_layer"))
         << "icosphere level " << resolution;
   }
+}
+
+// At ν = 0.45 a central-spring network is too compressible (its Poisson's ratio is 1/4): the volume
+// preservation energy has to bring the volumetric tet_edges network, which shares the FEM's
+// mesh, much closer, and the three tiers closer too, on the same run (statics and timing).
+TEST(Sanity, VolumePreservationBringsTheNetworksCloserAtNuPointFourFive) {
+  TemporaryDirectory dir;
+  std::map<std::string, std::map<std::string, nlohmann::json>> by_setting;
+  for (const std::string setting : {"false", "true"}) {
+    const auto out = dir / ("run-" + setting);
+    const auto r = run_msfem("run " + cases_dir +
+                             "/sphere_indent.prm --quiet --set timing/steps=100 --set "
+                             "'mass spring/variants=tet_edges,three_tier' --set 'mass "
+                             "spring/volume preservation=" +
+                             setting + "' --out " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(read_text(out / "summary.json"));
+    for (const auto& v : j["variants"])
+      by_setting[setting][v["name"].get<std::string>()] = v;
+  }
+  const auto& off = by_setting["false"];
+  const auto& on = by_setting["true"];
+  for (const char* name : {"tet_edges", "three_tier"}) {
+    ASSERT_TRUE(off.count(name) && on.count(name)) << name;
+    EXPECT_FALSE(off.at(name)["parameters"].contains("volume_preservation")) << name;
+    ASSERT_TRUE(on.at(name)["parameters"].contains("volume_preservation")) << name;
+    EXPECT_GT(on.at(name)["steps_per_second"].get<double>(), 0.0) << name;
+    EXPECT_TRUE(std::isfinite(on.at(name)["stable_dt_s"].get<double>())) << name;
+  }
+  EXPECT_LT(on.at("tet_edges")["rel_l2_error"].get<double>(),
+            0.4 * off.at("tet_edges")["rel_l2_error"].get<double>());
+  EXPECT_LT(on.at("three_tier")["rel_l2_error"].get<double>(),
+            0.8 * off.at("three_tier")["rel_l2_error"].get<double>());
+  // Bulk stiffness only adds resistance: the tool pushes back harder with it.
+  EXPECT_GT(on.at("tet_edges")["reaction_force_N"][2].get<double>(),
+            off.at("tet_edges")["reaction_force_N"][2].get<double>());
 }
 
 class ForceDepth : public ::testing::TestWithParam<const char*> {};

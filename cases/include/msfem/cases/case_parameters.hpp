@@ -81,6 +81,8 @@ struct MassSpringParameters {
   std::string stiffness_model = "lloyd";  ///< lloyd | van_gelder
   double damping_ratio = 0.5;             ///< spring dampers as a fraction of critical
   std::vector<std::pair<std::string, double>> group_scales;  ///< "group:factor" overrides
+  /// three_tier's prisms and tet_edges' tetrahedra resist volume change (group "volume").
+  bool volume_preservation = false;
   double middle_tier_scale = 1.2;
   double inner_tier_scale = 2.0;
   std::string inner_tiers = "scaled";  ///< scaled | offset (along the inward normal)

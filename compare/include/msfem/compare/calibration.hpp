@@ -48,7 +48,9 @@ struct ErrorsOnLoads {
 
 struct FittedGroup {
   std::string group;
-  int springs = 0;
+  int springs = 0;  ///< springs in the group (volume elements for the volume group)
+  /// "N/m" for a spring group; "Pa" for the volume group, whose "stiffness" is the modulus κ.
+  std::string unit = "N/m";
   double start_stiffness_n_per_m = 0.0;  ///< mean over the group's springs, at the start
   double factor = 1.0;                   ///< fitted / start
   double fitted_stiffness_n_per_m = 0.0;

@@ -17,6 +17,10 @@ namespace msfem::compare {
 /// The variants a case may name.
 const std::vector<std::string>& known_variants();
 
+/// The name under which `mass spring/group scales` and msfem calibrate scale the volume
+/// preservation modulus (`mass spring/volume preservation`).
+inline constexpr const char* volume_group = "volume";
+
 /// Builds the variant's network with the case's material and options, and applies the shared
 /// supports, gravity, patch force and (when given) the tool as prescribed displacement of the same
 /// patch the FEM prescribes. `mesh` is the FEM's volume mesh (tet_edges springs its edges). Throws

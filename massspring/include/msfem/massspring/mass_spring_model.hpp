@@ -9,6 +9,7 @@
 #include "msfem/massspring/spring_force_field.hpp"
 #include "msfem/massspring/spring_network.hpp"
 #include "msfem/massspring/tool_contact.hpp"
+#include "msfem/massspring/volume_force_field.hpp"
 
 namespace msfem::massspring {
 
@@ -58,6 +59,12 @@ class MassSpringModel : public ForceModel {
   void clear_contact() { contact_.reset(); }
   const std::optional<SphereContactForceField>& contact() const { return contact_; }
 
+  // --- volume preservation (the bulk stiffness central springs lack) ---
+  void set_volume(const VolumeForceField& volume);
+  void clear_volume() { volume_.reset(); }
+  const std::optional<VolumeForceField>& volume() const { return volume_; }
+  std::optional<VolumeForceField>& volume() { return volume_; }
+
   // --- ForceModel ---
   int num_dofs() const override { return 3 * num_nodes(); }
   void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
@@ -101,6 +108,7 @@ class MassSpringModel : public ForceModel {
   std::vector<char> constrained_;
   Eigen::MatrixX3d prescribed_displacement_;
   std::optional<SphereContactForceField> contact_;
+  std::optional<VolumeForceField> volume_;
 };
 
 }  // namespace msfem::massspring

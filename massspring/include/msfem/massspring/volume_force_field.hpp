@@ -1,0 +1,76 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "msfem/massspring/force_model.hpp"
+
+namespace msfem::massspring {
+
+/// Volume elements of a network: element e has the volume V_e = Σ w_t V_t over the tetrahedra
+/// t = tet_start[e] .. tet_start[e + 1] - 1 (rows of `tets`, 4 node ids each, weights
+/// `tet_weight`), a signed rest volume and a modulus κ_e (Pa). A tetrahedron of a volume mesh is
+/// an element of one tetrahedron of weight 1. A three-tier shell prism between a surface triangle
+/// and its inner copy is an element of its three 3-tetrahedron decompositions (one starting at
+/// each corner), weight 1/3 each: one decomposition alone depends on the vertex order, which made
+/// the response differ from one tool position to another.
+struct VolumeElements {
+  Eigen::MatrixX4i tets;
+  Eigen::VectorXd tet_weight;     ///< per tetrahedron
+  std::vector<int> tet_start{0};  ///< size elements + 1
+  Eigen::VectorXd rest_volume;    ///< per element, m³ (signed)
+  Eigen::VectorXd modulus;        ///< per element, Pa (>= 0)
+
+  int num_elements() const { return static_cast<int>(tet_start.size()) - 1; }
+};
+
+/// Volume preservation: U = Σ_e ½ κ_e (V_e − V_e⁰)² / |V_e⁰|. For small strains V/V⁰ − 1 = tr ε, so
+/// this is the continuum's ½ κ (tr ε)² per unit volume: it adds the bulk stiffness that a network
+/// of central springs lacks (its Poisson's ratio is pinned at 1/4 by the Cauchy relations), with
+/// κ = λ(E, ν) − λ(E, 1/4) as the analytic start for a tissue of Poisson's ratio ν.
+class VolumeForceField : public ForceModel {
+ public:
+  /// Throws ModelError for node ids outside [0, num_nodes), a degenerate rest volume, a negative or
+  /// non-finite modulus, or inconsistent sizes.
+  VolumeForceField(int num_nodes, VolumeElements elements);
+
+  int num_dofs() const override { return 3 * num_nodes_; }
+  void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                 Eigen::VectorXd& f) const override;
+  double potential_energy(const Eigen::VectorXd& x) const override;
+  void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                        const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                        Linearisation mode = Linearisation::exact) const override;
+  void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                        Eigen::VectorXd&) const override {}
+  void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
+                         Linearisation mode = Linearisation::exact) const override;
+  void add_dfdv_triplets(const Eigen::VectorXd&, Triplets&) const override {}
+
+  const VolumeElements& elements() const { return elements_; }
+  void set_modulus(const Eigen::VectorXd& modulus);  ///< per element, Pa
+  void scale_modulus(double factor);
+  /// Current signed volume of element e at x.
+  double volume(const Eigen::VectorXd& x, int e) const;
+
+ private:
+  int num_nodes_;
+  VolumeElements elements_;
+};
+
+/// The prisms between a triangle mesh's tiers: for every triangle (a, b, c) of `triangles` and
+/// every pair of consecutive tiers (node id = tier · `nodes_per_tier` + vertex), one element (see
+/// VolumeElements), with its rest volume from `rest_positions` and the given modulus.
+VolumeElements tier_prisms(const Eigen::MatrixX3d& rest_positions,
+                           const Eigen::MatrixX3i& triangles, int nodes_per_tier, int tiers,
+                           double modulus);
+
+/// One element per tetrahedron of a volume mesh (tet_edges), with the given modulus.
+VolumeElements tetrahedron_elements(const Eigen::MatrixX3d& rest_positions,
+                                    const Eigen::MatrixX4i& tets, double modulus);
+
+/// κ to add to a central-spring network so that it has the bulk response of an isotropic solid
+/// of Young's modulus E and Poisson's ratio ν: λ(E, ν) − λ(E, 1/4) (0 for ν ≤ 1/4).
+double volume_modulus_for(double youngs_modulus, double poisson_ratio);
+
+}  // namespace msfem::massspring

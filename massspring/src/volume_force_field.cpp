@@ -1,0 +1,289 @@
+#include "msfem/massspring/volume_force_field.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "msfem/massspring/errors.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+Mat3 cross_matrix(const Vec3& v) {
+  Mat3 m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+// One tetrahedron at x: its four node ids, V = (1/6) e1 · (e2 × e3) with e_i = x_i − x_0, and
+// ∂V/∂x_i.
+struct Tet {
+  std::array<int, 4> nodes;
+  std::array<Vec3, 4> p;
+  double volume = 0.0;
+  std::array<Vec3, 4> gradient;
+
+  double weight = 1.0;
+
+  Tet(const Eigen::MatrixX4i& tets, int t, const Eigen::VectorXd& x, double w = 1.0) : weight(w) {
+    for (int i = 0; i < 4; ++i) {
+      nodes[i] = tets(t, i);
+      p[i] = x.segment<3>(3 * nodes[i]);
+    }
+    const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0], e3 = p[3] - p[0];
+    const double s = w / 6.0;
+    volume = s * e1.dot(e2.cross(e3));
+    gradient[1] = s * e2.cross(e3);
+    gradient[2] = s * e3.cross(e1);
+    gradient[3] = s * e1.cross(e2);
+    gradient[0] = -(gradient[1] + gradient[2] + gradient[3]);
+  }
+  Tet(const VolumeElements& el, int t, const Eigen::VectorXd& x)
+      : Tet(el.tets, t, x, el.tet_weight[t]) {}
+
+  // ∂²V/∂x_i∂x_j: with the edge vectors, H(e1,e2) = −[e3]×/6, H(e1,e3) = [e2]×/6,
+  // H(e2,e3) = −[e1]×/6 (and transposes); node 0 takes minus the sums, as e_i = x_i − x_0.
+  Mat3 hessian(int i, int j) const {
+    if (i == j) return Mat3::Zero();
+    const Vec3 e[4] = {Vec3::Zero(), p[1] - p[0], p[2] - p[0], p[3] - p[0]};
+    auto edge_block = [&](int a, int b) -> Mat3 {  // a, b in 1..3, a != b
+      const int c = 6 - a - b;
+      // H(e_a, e_b) = ±[e_c]×/6 with the sign of the permutation (a, b, c).
+      const bool even = (a == 1 && b == 2) || (a == 2 && b == 3) || (a == 3 && b == 1);
+      return (even ? -weight : weight) * cross_matrix(e[c]) / 6.0;
+    };
+    if (i != 0 && j != 0) return edge_block(i, j);
+    // Row or column 0: minus the sum over the other index (the diagonal edge blocks are zero).
+    Mat3 sum = Mat3::Zero();
+    const int other = i == 0 ? j : i;
+    for (int k = 1; k < 4; ++k)
+      if (k != other) sum += i == 0 ? edge_block(k, other) : edge_block(other, k);
+    return -sum;
+  }
+};
+
+}  // namespace
+
+VolumeForceField::VolumeForceField(int num_nodes, VolumeElements elements)
+    : num_nodes_(num_nodes), elements_(std::move(elements)) {
+  const int n = elements_.num_elements();
+  if (n < 0 || elements_.tet_start.front() != 0 ||
+      elements_.tet_start.back() != elements_.tets.rows())
+    throw ModelError("volume elements: tet_start must run from 0 to the number of tetrahedra");
+  if (elements_.tet_weight.size() != elements_.tets.rows() || !elements_.tet_weight.allFinite())
+    throw ModelError("volume elements: " + std::to_string(elements_.tets.rows()) +
+                     " tetrahedra but " + std::to_string(elements_.tet_weight.size()) +
+                     " finite weights");
+  if (elements_.rest_volume.size() != n || elements_.modulus.size() != n)
+    throw ModelError("volume elements: " + std::to_string(n) + " elements but " +
+                     std::to_string(elements_.rest_volume.size()) + " rest volumes and " +
+                     std::to_string(elements_.modulus.size()) + " moduli");
+  for (int e = 0; e < n; ++e) {
+    if (elements_.tet_start[e + 1] <= elements_.tet_start[e])
+      throw ModelError("volume element " + std::to_string(e) + " has no tetrahedron");
+    if (!(std::abs(elements_.rest_volume[e]) > 0.0) || !std::isfinite(elements_.rest_volume[e]))
+      throw ModelError("volume element " + std::to_string(e) + " has rest volume " +
+                       std::to_string(elements_.rest_volume[e]));
+    if (!(elements_.modulus[e] >= 0.0) || !std::isfinite(elements_.modulus[e]))
+      throw ModelError("volume element " + std::to_string(e) + " has modulus " +
+                       std::to_string(elements_.modulus[e]) + " Pa");
+  }
+  for (Eigen::Index t = 0; t < elements_.tets.rows(); ++t)
+    for (int i = 0; i < 4; ++i)
+      if (elements_.tets(t, i) < 0 || elements_.tets(t, i) >= num_nodes_)
+        throw ModelError("volume tetrahedron " + std::to_string(t) + " names node " +
+                         std::to_string(elements_.tets(t, i)) + " of " +
+                         std::to_string(num_nodes_));
+}
+
+void VolumeForceField::set_modulus(const Eigen::VectorXd& modulus) {
+  if (modulus.size() != elements_.num_elements() || !modulus.allFinite() ||
+      (modulus.array() < 0.0).any())
+    throw ModelError("volume moduli: need " + std::to_string(elements_.num_elements()) +
+                     " finite values >= 0");
+  elements_.modulus = modulus;
+}
+
+void VolumeForceField::scale_modulus(double factor) {
+  if (!(factor >= 0.0) || !std::isfinite(factor))
+    throw ModelError("volume modulus factor " + std::to_string(factor) + " must be finite, >= 0");
+  elements_.modulus *= factor;
+}
+
+double VolumeForceField::volume(const Eigen::VectorXd& x, int e) const {
+  double v = 0.0;
+  for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t)
+    v += Tet(elements_, t, x).volume;
+  return v;
+}
+
+void VolumeForceField::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd&,
+                                 Eigen::VectorXd& f) const {
+  for (int e = 0; e < elements_.num_elements(); ++e) {
+    const double v0 = elements_.rest_volume[e];
+    const double pressure = elements_.modulus[e] * (volume(x, e) - v0) / std::abs(v0);
+    for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t) {
+      const Tet tet(elements_, t, x);
+      for (int i = 0; i < 4; ++i)
+        f.segment<3>(3 * tet.nodes[i]) -= pressure * tet.gradient[i];
+    }
+  }
+}
+
+double VolumeForceField::potential_energy(const Eigen::VectorXd& x) const {
+  double energy = 0.0;
+  for (int e = 0; e < elements_.num_elements(); ++e) {
+    const double dv = volume(x, e) - elements_.rest_volume[e];
+    energy += 0.5 * elements_.modulus[e] * dv * dv / std::abs(elements_.rest_volume[e]);
+  }
+  return energy;
+}
+
+// ∂f/∂x = −(κ/|V⁰|) (g gᵀ + (V − V⁰) ∂²V): the first term is negative semi-definite and is all
+// the definite linearisation keeps.
+void VolumeForceField::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd&,
+                                        const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                                        Linearisation mode) const {
+  for (int e = 0; e < elements_.num_elements(); ++e) {
+    const double scale = elements_.modulus[e] / std::abs(elements_.rest_volume[e]);
+    if (scale == 0.0) continue;
+    double dv = 0.0, g_dx = 0.0;
+    for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t) {
+      const Tet tet(elements_, t, x);
+      dv += tet.volume;
+      for (int i = 0; i < 4; ++i)
+        g_dx += tet.gradient[i].dot(dx.segment<3>(3 * tet.nodes[i]));
+    }
+    dv -= elements_.rest_volume[e];
+    for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t) {
+      const Tet tet(elements_, t, x);
+      for (int i = 0; i < 4; ++i) {
+        Vec3 out = g_dx * tet.gradient[i];
+        if (mode == Linearisation::exact)
+          for (int j = 0; j < 4; ++j)
+            out += dv * (tet.hessian(i, j) * dx.segment<3>(3 * tet.nodes[j]));
+        df.segment<3>(3 * tet.nodes[i]) -= scale * out;
+      }
+    }
+  }
+}
+
+void VolumeForceField::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd&,
+                                         Triplets& triplets, Linearisation mode) const {
+  std::vector<int> nodes;
+  std::vector<Vec3> gradient;
+  for (int e = 0; e < elements_.num_elements(); ++e) {
+    const double scale = elements_.modulus[e] / std::abs(elements_.rest_volume[e]);
+    if (scale == 0.0) continue;
+    // The element's gradient gathered per distinct node, so g gᵀ is emitted once per node pair.
+    nodes.clear();
+    gradient.clear();
+    double dv = -elements_.rest_volume[e];
+    for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t) {
+      const Tet tet(elements_, t, x);
+      dv += tet.volume;
+      for (int i = 0; i < 4; ++i) {
+        std::size_t k = 0;
+        while (k < nodes.size() && nodes[k] != tet.nodes[i])
+          ++k;
+        if (k == nodes.size()) {
+          nodes.push_back(tet.nodes[i]);
+          gradient.push_back(Vec3::Zero());
+        }
+        gradient[k] += tet.gradient[i];
+      }
+    }
+    for (std::size_t a = 0; a < nodes.size(); ++a)
+      for (std::size_t b = 0; b < nodes.size(); ++b) {
+        const Mat3 block = -scale * gradient[a] * gradient[b].transpose();
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            triplets.emplace_back(3 * nodes[a] + r, 3 * nodes[b] + c, block(r, c));
+      }
+    if (mode != Linearisation::exact || dv == 0.0) continue;
+    for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t) {
+      const Tet tet(elements_, t, x);
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+          if (i == j) continue;
+          const Mat3 block = -scale * dv * tet.hessian(i, j);
+          for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+              triplets.emplace_back(3 * tet.nodes[i] + r, 3 * tet.nodes[j] + c, block(r, c));
+        }
+    }
+  }
+}
+
+namespace {
+
+Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions) {
+  Eigen::VectorXd x(3 * positions.rows());
+  for (Eigen::Index i = 0; i < positions.rows(); ++i)
+    x.segment<3>(3 * i) = positions.row(i).transpose();
+  return x;
+}
+
+void finish_rest_volumes(VolumeElements& elements, const Eigen::MatrixX3d& rest_positions,
+                         double modulus) {
+  const Eigen::VectorXd rest = flatten_positions(rest_positions);
+  const int n = elements.num_elements();
+  elements.rest_volume.resize(n);
+  elements.modulus = Eigen::VectorXd::Constant(n, modulus);
+  for (int e = 0; e < n; ++e) {
+    double v = 0.0;
+    for (int t = elements.tet_start[e]; t < elements.tet_start[e + 1]; ++t)
+      v += Tet(elements, t, rest).volume;
+    elements.rest_volume[e] = v;
+  }
+}
+
+}  // namespace
+
+VolumeElements tier_prisms(const Eigen::MatrixX3d& rest_positions,
+                           const Eigen::MatrixX3i& triangles, int nodes_per_tier, int tiers,
+                           double modulus) {
+  VolumeElements elements;
+  const Eigen::Index count = triangles.rows() * std::max(tiers - 1, 0);
+  elements.tets.resize(9 * count, 4);
+  elements.tet_weight = Eigen::VectorXd::Constant(9 * count, 1.0 / 3.0);
+  int t = 0;
+  for (int tier = 0; tier + 1 < tiers; ++tier)
+    for (Eigen::Index f = 0; f < triangles.rows(); ++f) {
+      const int o = tier * nodes_per_tier, i = (tier + 1) * nodes_per_tier;
+      for (int r = 0; r < 3; ++r) {
+        const int a = triangles(f, r), b = triangles(f, (r + 1) % 3), c = triangles(f, (r + 2) % 3);
+        // The prism a b c / a' b' c' as (a b c a'), (b c a' b'), (c a' b' c'): all three have
+        // the prism's orientation, so their signed volumes add up to its volume.
+        elements.tets.row(t++) << o + a, o + b, o + c, i + a;
+        elements.tets.row(t++) << o + b, o + c, i + a, i + b;
+        elements.tets.row(t++) << o + c, i + a, i + b, i + c;
+      }
+      elements.tet_start.push_back(t);
+    }
+  finish_rest_volumes(elements, rest_positions, modulus);
+  return elements;
+}
+
+VolumeElements tetrahedron_elements(const Eigen::MatrixX3d& rest_positions,
+                                    const Eigen::MatrixX4i& tets, double modulus) {
+  VolumeElements elements;
+  elements.tets = tets;
+  elements.tet_weight = Eigen::VectorXd::Ones(tets.rows());
+  for (Eigen::Index t = 0; t < tets.rows(); ++t)
+    elements.tet_start.push_back(static_cast<int>(t) + 1);
+  finish_rest_volumes(elements, rest_positions, modulus);
+  return elements;
+}
+
+double volume_modulus_for(double youngs_modulus, double poisson_ratio) {
+  auto lambda = [&](double nu) { return youngs_modulus * nu / ((1 + nu) * (1 - 2 * nu)); };
+  return poisson_ratio <= 0.25 ? 0.0 : lambda(poisson_ratio) - lambda(0.25);
+}
+
+}  // namespace msfem::massspring

@@ -1,0 +1,183 @@
+// Volume preservation: its Jacobians and energy against finite differences, the prism split against
+// the closed-form shell volume, and the bulk response it adds against λ(E, ν) − λ(E, 1/4).
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "force_jacobian_check.hpp"
+#include "icosphere.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_implicit_stepper.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+#include "msfem/massspring/volume_force_field.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+using testing::check_force_jacobians;
+using testing::icosphere;
+
+Eigen::VectorXd flat(const Eigen::MatrixX3d& positions) {
+  Eigen::VectorXd x(3 * positions.rows());
+  for (Eigen::Index i = 0; i < positions.rows(); ++i)
+    x.segment<3>(3 * i) = positions.row(i).transpose();
+  return x;
+}
+
+Eigen::VectorXd perturbed(const Eigen::VectorXd& x, double amplitude, unsigned seed) {
+  std::mt19937 generator(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd result = x;
+  for (Eigen::Index k = 0; k < x.size(); ++k)
+    result[k] += amplitude * uniform(generator);
+  return result;
+}
+
+SpringNetwork three_tier_sphere(int level) {
+  const auto mesh = icosphere(level, 0.05);
+  return build_three_tier(mesh.vertices, mesh.triangles, ThreeTierOptions{});
+}
+
+TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
+  const SpringNetwork network = three_tier_sphere(1);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  const VolumeForceField volume(
+      network.num_nodes(),
+      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 8000.0));
+  // Perturbed by a fifth of the 2.5 cm shell: every element away from its rest volume.
+  const Eigen::VectorXd x = perturbed(flat(network.rest_positions), 0.004, 3);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
+  volume.add_force(x, Eigen::VectorXd::Zero(x.size()), f);
+  ASSERT_GT(f.norm(), 0.0);
+  const auto errors = check_force_jacobians(volume, x, Eigen::VectorXd::Zero(x.size()), 1e-7);
+  EXPECT_LE(errors.dfdx_matrix, 1e-6);
+  EXPECT_LE(errors.dfdx_product, 1e-6);
+  EXPECT_LE(errors.energy_gradient, 1e-6);
+  // Internal: the forces sum to zero and exert no net moment (V is invariant under rigid motion).
+  Eigen::Vector3d total = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+  for (int i = 0; i < network.num_nodes(); ++i) {
+    total += f.segment<3>(3 * i);
+    moment += x.segment<3>(3 * i).cross(f.segment<3>(3 * i));
+  }
+  EXPECT_LE(total.norm(), 1e-12 * f.norm());
+  EXPECT_LE(moment.norm(), 1e-12 * f.norm() * 0.05);
+}
+
+TEST(VolumeForceField, PrismsRespondAlikeWhicheverCornerTheirTrianglesStartAt) {
+  // Rotating each triangle's vertex order must not change the element's volume away from rest
+  // (one 3-tetrahedron split alone does: its diagonals depend on the order).
+  const SpringNetwork network = three_tier_sphere(1);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  Eigen::MatrixX3i rotated = network.surface_triangles;
+  for (Eigen::Index f = 0; f < rotated.rows(); ++f)
+    rotated.row(f) << network.surface_triangles(f, 1), network.surface_triangles(f, 2),
+        network.surface_triangles(f, 0);
+  const VolumeForceField a(network.num_nodes(), tier_prisms(network.rest_positions,
+                                                            network.surface_triangles, nv, 3, 1.0));
+  const VolumeForceField b(network.num_nodes(),
+                           tier_prisms(network.rest_positions, rotated, nv, 3, 1.0));
+  const Eigen::VectorXd x = perturbed(flat(network.rest_positions), 0.004, 11);
+  for (int e = 0; e < a.elements().num_elements(); ++e)
+    EXPECT_NEAR(a.volume(x, e), b.volume(x, e), 1e-12 * std::abs(a.volume(x, e))) << e;
+}
+
+TEST(VolumeForceField, TetrahedronElementsJacobiansMatchFiniteDifferences) {
+  // Two positively oriented tetrahedra sharing the face 1 2 3.
+  Eigen::MatrixX3d p(5, 3);
+  p << 0, 0, 0, 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01, 0.01, 0.01, 0.01;
+  Eigen::MatrixX4i tets(2, 4);
+  tets << 0, 1, 2, 3, 1, 2, 3, 4;
+  const VolumeElements elements = tetrahedron_elements(p, tets, 5000.0);
+  EXPECT_NEAR(elements.rest_volume[0], 1e-6 / 6.0, 1e-18);
+  EXPECT_NEAR(elements.rest_volume[1], 2e-6 / 6.0, 1e-18);
+  const VolumeForceField volume(5, elements);
+  const Eigen::VectorXd x = perturbed(flat(p), 0.002, 5);
+  const auto errors = check_force_jacobians(volume, x, Eigen::VectorXd::Zero(x.size()), 1e-8);
+  EXPECT_LE(errors.dfdx_matrix, 1e-6);
+  EXPECT_LE(errors.dfdx_product, 1e-6);
+  EXPECT_LE(errors.energy_gradient, 1e-6);
+}
+
+TEST(VolumeForceField, PrismsFillTheShellsBetweenTheTiers) {
+  // The icosphere's tiers are scaled copies, so the prisms between tiers s1 and s2 fill exactly
+  // the enclosed polyhedra's volume difference, (1/s1³ − 1/s2³) V_outer.
+  const auto mesh = icosphere(2, 0.05);
+  const SpringNetwork network = build_three_tier(mesh.vertices, mesh.triangles, ThreeTierOptions{});
+  const int nv = static_cast<int>(mesh.vertices.rows());
+  const VolumeElements prisms = tier_prisms(network.rest_positions, mesh.triangles, nv, 3, 1.0);
+  ASSERT_EQ(prisms.num_elements(), 2 * mesh.triangles.rows());
+  double outer = 0.0;
+  for (Eigen::Index f = 0; f < mesh.triangles.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.vertices.row(mesh.triangles(f, 0)).transpose();
+    const Eigen::Vector3d b = mesh.vertices.row(mesh.triangles(f, 1)).transpose();
+    const Eigen::Vector3d c = mesh.vertices.row(mesh.triangles(f, 2)).transpose();
+    outer += a.dot(b.cross(c)) / 6.0;
+  }
+  const Eigen::Index half = mesh.triangles.rows();
+  const double shell12 = prisms.rest_volume.head(half).sum();
+  const double shell23 = prisms.rest_volume.tail(half).sum();
+  // Outward triangles over inward-pointing prisms: every prism volume has one sign.
+  EXPECT_TRUE((prisms.rest_volume.array() < 0).all() || (prisms.rest_volume.array() > 0).all());
+  EXPECT_NEAR(std::abs(shell12), outer * (1 - 1 / std::pow(1.2, 3)), 1e-12 * outer);
+  EXPECT_NEAR(std::abs(shell23), outer * (1 / std::pow(1.2, 3) - 1 / 8.0), 1e-12 * outer);
+}
+
+TEST(VolumeForceField, UniformDilatationCostsTheBulkEnergyOfTheModulus) {
+  // Scaling every node by (1 + ε) changes each volume by (1 + ε)³ − 1: U = ½ κ V⁰ ((1+ε)³ − 1)²,
+  // the continuum's ½ κ (tr ε)² V⁰ to first order.
+  const SpringNetwork network = three_tier_sphere(2);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  const double kappa = volume_modulus_for(3000.0, 0.45);
+  const VolumeForceField volume(
+      network.num_nodes(),
+      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, kappa));
+  const double eps = 1e-3;
+  const Eigen::VectorXd x = (1 + eps) * flat(network.rest_positions);
+  const double total_rest = volume.elements().rest_volume.cwiseAbs().sum();
+  const double dv = std::pow(1 + eps, 3) - 1;
+  EXPECT_NEAR(volume.potential_energy(x), 0.5 * kappa * total_rest * dv * dv,
+              1e-9 * 0.5 * kappa * total_rest * dv * dv);
+  EXPECT_NEAR(kappa, 3000.0 * (0.45 / (1.45 * 0.1) - 0.25 / (1.25 * 0.5)), 1e-9);
+  EXPECT_EQ(volume_modulus_for(3000.0, 0.25), 0.0);
+  EXPECT_EQ(volume_modulus_for(3000.0, 0.2), 0.0);
+}
+
+TEST(VolumeForceField, RejectsBadElements) {
+  const SpringNetwork network = three_tier_sphere(1);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  VolumeElements good = tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 1.0);
+  VolumeElements bad_node = good;
+  bad_node.tets(5, 2) = network.num_nodes();
+  EXPECT_THROW(VolumeForceField(network.num_nodes(), bad_node), ModelError);
+  VolumeElements bad_modulus = good;
+  bad_modulus.modulus[1] = std::nan("");
+  EXPECT_THROW(VolumeForceField(network.num_nodes(), bad_modulus), ModelError);
+  VolumeElements bad_weight = good;
+  bad_weight.tet_weight.conservativeResize(bad_weight.tet_weight.size() - 1);
+  EXPECT_THROW(VolumeForceField(network.num_nodes(), bad_weight), ModelError);
+  VolumeElements flat_element = good;
+  flat_element.rest_volume[0] = 0.0;
+  EXPECT_THROW(VolumeForceField(network.num_nodes(), flat_element), ModelError);
+  MassSpringModel model(network);
+  EXPECT_THROW(model.set_volume(VolumeForceField(nv, VolumeElements{})), ModelError);
+}
+
+TEST(VolumeForceField, FastSteppersRefuseAModelWhoseVolumeTheyWouldDrop) {
+  const SpringNetwork network = three_tier_sphere(1);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  MassSpringModel model(network);
+  EXPECT_NO_THROW(FastExplicitStepper{model});
+  model.set_volume(VolumeForceField(
+      network.num_nodes(),
+      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 1000.0)));
+  EXPECT_THROW(FastExplicitStepper{model}, ModelError);
+  EXPECT_THROW(FastImplicitStepper{model}, ModelError);
+}
+
+}  // namespace
+}  // namespace msfem::massspring
