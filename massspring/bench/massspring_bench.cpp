@@ -1,6 +1,7 @@
 // Steps per second of the mass-spring steppers on the seed sphere, the brain and 10 x the brain:
 // FastExplicitStepper (SoA, 2 threads, double and float), the naive scalar AoS loop, and
-// FastImplicitStepper at the haptic step of 1 ms. `--benchmark_filter=brain_scale` etc.
+// FastImplicitStepper at the haptic step of 1 ms; one force evaluation of the springs and of the
+// volume preservation. `--benchmark_filter=brain_scale` etc.
 
 #include <benchmark/benchmark.h>
 
@@ -12,6 +13,7 @@
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/stepping_benchmark.hpp"
+#include "msfem/massspring/volume_force_field.hpp"
 #include "obj_surface.hpp"
 
 namespace {
@@ -86,7 +88,38 @@ void implicit_step(benchmark::State& state, const std::string& name, bool single
   state.counters["threads"] = static_cast<double>(thread_steps) / steps;
 }
 
+// One force evaluation of the three tiers' springs (the generic SpringForceField, which Newton and
+// the generic integrators call), and of the volume preservation on their shell prisms: the ratio
+// of the two is what the volume term adds to a step that evaluates both.
+void forces(benchmark::State& state, const std::string& name, bool volume) {
+  const MassSpringModel& model = model_for(name);
+  const int nv = static_cast<int>(model.network().surface_nodes.size());
+  const VolumeForceField prisms(model.num_nodes(),
+                                tier_prisms(model.network().rest_positions,
+                                            model.network().surface_triangles, nv, 3, 8000.0));
+  const Eigen::VectorXd x = perturbed_start(model).x;
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  Eigen::VectorXd f(x.size());
+  for (auto _ : state) {
+    f.setZero();
+    if (volume)
+      prisms.add_force(x, v, f);
+    else
+      model.springs().add_force(x, v, f);
+    benchmark::DoNotOptimize(f.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["elements"] =
+      volume ? prisms.elements().num_elements() : model.network().num_springs();
+}
+
 void register_all() {
+  for (const std::string name : {"seed_sphere", "brain_scale"}) {
+    benchmark::RegisterBenchmark(("forces_springs/" + name).c_str(), forces, name, false)
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("forces_volume_prisms/" + name).c_str(), forces, name, true)
+        ->Unit(benchmark::kMicrosecond);
+  }
   for (const std::string name : {"seed_sphere", "brain_scale", "brain_10x"}) {
     benchmark::RegisterBenchmark(("explicit_soa_double_2threads/" + name).c_str(), explicit_step,
                                  name, false, 2, true)

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "msfem/massspring/errors.hpp"
 
@@ -124,14 +125,21 @@ double VolumeForceField::volume(const Eigen::VectorXd& x, int e) const {
 
 void VolumeForceField::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd&,
                                  Eigen::VectorXd& f) const {
+  // One pass per element: its tetrahedra are kept while the volume is summed (a prism has nine),
+  // so each is built once, not once for V and again for the gradient.
+  std::vector<Tet> tets;
   for (int e = 0; e < elements_.num_elements(); ++e) {
     const double v0 = elements_.rest_volume[e];
-    const double pressure = elements_.modulus[e] * (volume(x, e) - v0) / std::abs(v0);
+    tets.clear();
+    double v = 0.0;
     for (int t = elements_.tet_start[e]; t < elements_.tet_start[e + 1]; ++t) {
-      const Tet tet(elements_, t, x);
+      tets.emplace_back(elements_, t, x);
+      v += tets.back().volume;
+    }
+    const double pressure = elements_.modulus[e] * (v - v0) / std::abs(v0);
+    for (const Tet& tet : tets)
       for (int i = 0; i < 4; ++i)
         f.segment<3>(3 * tet.nodes[i]) -= pressure * tet.gradient[i];
-    }
   }
 }
 
