@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/spring_network.hpp"
 
 namespace msfem::massspring {
 namespace {
@@ -230,16 +231,9 @@ void VolumeForceField::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::
 
 namespace {
 
-Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions) {
-  Eigen::VectorXd x(3 * positions.rows());
-  for (Eigen::Index i = 0; i < positions.rows(); ++i)
-    x.segment<3>(3 * i) = positions.row(i).transpose();
-  return x;
-}
-
 void finish_rest_volumes(VolumeElements& elements, const Eigen::MatrixX3d& rest_positions,
                          double modulus) {
-  const Eigen::VectorXd rest = flatten_positions(rest_positions);
+  const Eigen::VectorXd rest = flatten(rest_positions);
   const int n = elements.num_elements();
   elements.rest_volume.resize(n);
   elements.modulus = Eigen::VectorXd::Constant(n, modulus);

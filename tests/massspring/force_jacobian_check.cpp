@@ -21,6 +21,10 @@ Eigen::VectorXd random_direction(Eigen::Index n, unsigned seed) {
 
 }  // namespace
 
+Eigen::VectorXd perturbed(const Eigen::VectorXd& x, double amplitude, unsigned seed) {
+  return x + amplitude * random_direction(x.size(), seed);
+}
+
 JacobianErrors check_force_jacobians(const ForceModel& model, const Eigen::VectorXd& x,
                                      const Eigen::VectorXd& v, double step) {
   const Eigen::Index n = model.num_dofs();

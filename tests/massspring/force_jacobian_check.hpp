@@ -18,6 +18,9 @@ struct JacobianErrors {
   double energy_gradient = 0.0;  ///< |f(x, 0) + ∇U_fd| / |f(x, 0)|
 };
 
+/// x plus a uniform random perturbation in [-amplitude, amplitude] per entry (seeded: repeatable).
+Eigen::VectorXd perturbed(const Eigen::VectorXd& x, double amplitude, unsigned seed);
+
 /// `step` is the finite-difference step in metres (or m/s for ∂f/∂v).
 JacobianErrors check_force_jacobians(const ForceModel& model, const Eigen::VectorXd& x,
                                      const Eigen::VectorXd& v, double step);

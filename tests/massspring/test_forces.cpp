@@ -15,15 +15,7 @@ namespace {
 
 using testing::check_force_jacobians;
 using testing::icosphere;
-
-Eigen::VectorXd perturbed(const Eigen::VectorXd& x, double amplitude, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd result = x;
-  for (Eigen::Index k = 0; k < x.size(); ++k)
-    result[k] += amplitude * uniform(generator);
-  return result;
-}
+using testing::perturbed;
 
 void expect_jacobians_match(const ForceModel& model, const Eigen::VectorXd& x,
                             const Eigen::VectorXd& v) {

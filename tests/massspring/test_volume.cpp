@@ -21,22 +21,7 @@ namespace {
 
 using testing::check_force_jacobians;
 using testing::icosphere;
-
-Eigen::VectorXd flat(const Eigen::MatrixX3d& positions) {
-  Eigen::VectorXd x(3 * positions.rows());
-  for (Eigen::Index i = 0; i < positions.rows(); ++i)
-    x.segment<3>(3 * i) = positions.row(i).transpose();
-  return x;
-}
-
-Eigen::VectorXd perturbed(const Eigen::VectorXd& x, double amplitude, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd result = x;
-  for (Eigen::Index k = 0; k < x.size(); ++k)
-    result[k] += amplitude * uniform(generator);
-  return result;
-}
+using testing::perturbed;
 
 SpringNetwork three_tier_sphere(int level) {
   const auto mesh = icosphere(level, 0.05);
@@ -50,7 +35,7 @@ TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
       network.num_nodes(),
       tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 8000.0));
   // Perturbed by a fifth of the 2.5 cm shell: every element away from its rest volume.
-  const Eigen::VectorXd x = perturbed(flat(network.rest_positions), 0.004, 3);
+  const Eigen::VectorXd x = perturbed(flatten(network.rest_positions), 0.004, 3);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
   volume.add_force(x, Eigen::VectorXd::Zero(x.size()), f);
   ASSERT_GT(f.norm(), 0.0);
@@ -81,7 +66,7 @@ TEST(VolumeForceField, PrismsRespondAlikeWhicheverCornerTheirTrianglesStartAt) {
                                                             network.surface_triangles, nv, 3, 1.0));
   const VolumeForceField b(network.num_nodes(),
                            tier_prisms(network.rest_positions, rotated, nv, 3, 1.0));
-  const Eigen::VectorXd x = perturbed(flat(network.rest_positions), 0.004, 11);
+  const Eigen::VectorXd x = perturbed(flatten(network.rest_positions), 0.004, 11);
   for (int e = 0; e < a.elements().num_elements(); ++e)
     EXPECT_NEAR(a.volume(x, e), b.volume(x, e), 1e-12 * std::abs(a.volume(x, e))) << e;
 }
@@ -96,7 +81,7 @@ TEST(VolumeForceField, TetrahedronElementsJacobiansMatchFiniteDifferences) {
   EXPECT_NEAR(elements.rest_volume[0], 1e-6 / 6.0, 1e-18);
   EXPECT_NEAR(elements.rest_volume[1], 2e-6 / 6.0, 1e-18);
   const VolumeForceField volume(5, elements);
-  const Eigen::VectorXd x = perturbed(flat(p), 0.002, 5);
+  const Eigen::VectorXd x = perturbed(flatten(p), 0.002, 5);
   const auto errors = check_force_jacobians(volume, x, Eigen::VectorXd::Zero(x.size()), 1e-8);
   EXPECT_LE(errors.dfdx_matrix, 1e-6);
   EXPECT_LE(errors.dfdx_product, 1e-6);
@@ -137,7 +122,7 @@ TEST(VolumeForceField, UniformDilatationCostsTheBulkEnergyOfTheModulus) {
       network.num_nodes(),
       tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, kappa));
   const double eps = 1e-3;
-  const Eigen::VectorXd x = (1 + eps) * flat(network.rest_positions);
+  const Eigen::VectorXd x = (1 + eps) * flatten(network.rest_positions);
   const double total_rest = volume.elements().rest_volume.cwiseAbs().sum();
   const double dv = std::pow(1 + eps, 3) - 1;
   EXPECT_NEAR(volume.potential_energy(x), 0.5 * kappa * total_rest * dv * dv,
