@@ -148,7 +148,16 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
      << " surface vertices not prescribed by a support or the tool\n"
      << "- FEM result " << (run.fem_from_cache ? "reused from the cache" : "computed") << " (key "
      << run.fem_cache_key << ")\n"
-     << "- git " << git_revision() << ", " << machine_description() << "\n\n";
+     << "- git " << git_revision() << ", " << machine_description() << "\n";
+  // Variants of the same name differ with and without it: say which tables are which.
+  std::string with_volume;
+  for (const auto& v : run.variants)
+    if (v.parameters.contains("volume_preservation"))
+      with_volume +=
+          (with_volume.empty() ? "" : ", ") + v.name + " (mean κ " +
+          std::to_string(v.parameters["volume_preservation"]["mean_modulus_pa"].get<double>()) +
+          " Pa)";
+  md << "- volume preservation: " << (with_volume.empty() ? "off" : with_volume) << "\n\n";
   for (const auto& n : run.problem.notes)
     md << "> note: " << n << "\n";
   md << "\n## Variants\n\n"

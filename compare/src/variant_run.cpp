@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "cholmod_factor.hpp"
@@ -76,6 +77,12 @@ ms::SpringNetwork build_network(const std::string& name, const Problem& problem,
                           "'");
 }
 
+std::string scientific(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
 // Damping of each spring as a fraction of critical for the two-body oscillator it forms.
 void set_damping_ratio(ms::MassSpringModel& model, double ratio) {
   const auto& n = model.network();
@@ -114,14 +121,24 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
   for (const auto& [group, factor] : p.mass_spring.group_scales)
     if (group == volume_group) modulus *= factor;
   const auto& rest = model.network().rest_positions;
+  ms::VolumeElements elements;
   if (variant.name == "three_tier")
-    model.set_volume(ms::VolumeForceField(
-        model.num_nodes(),
-        ms::tier_prisms(rest, problem.surface.triangles,
-                        static_cast<int>(problem.surface.num_vertices()), 3, modulus)));
+    elements = ms::tier_prisms(rest, problem.surface.triangles,
+                               static_cast<int>(problem.surface.num_vertices()), 3, modulus);
   else if (variant.name == "tet_edges")
-    model.set_volume(ms::VolumeForceField(
-        model.num_nodes(), ms::tetrahedron_elements(rest, variant.tetrahedra, modulus)));
+    elements = ms::tetrahedron_elements(rest, variant.tetrahedra, modulus);
+  else
+    return;
+  const int all = elements.num_elements();
+  // The brain's offset inner tiers fold where the surface is concave: such prisms are inverted or
+  // flat at rest, and with them Newton stalled (residual ~1e-7 N after 100 iterations).
+  if (const int removed = ms::remove_degenerate_elements(elements, model.rest_state(), 1e-3);
+      removed > 0)
+    variant.warnings.push_back(
+        "volume preservation: " + std::to_string(removed) + " of " + std::to_string(all) +
+        " volume elements are inverted or nearly flat at rest (folded tiers) and are left out");
+  if (elements.num_elements() > 0)
+    model.set_volume(ms::VolumeForceField(model.num_nodes(), std::move(elements)));
 }
 
 }  // namespace
@@ -227,7 +244,7 @@ StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::Ve
   if (!r.converged)
     throw std::runtime_error("variant " + variant.name + ": Newton did not converge in " +
                              std::to_string(r.iterations) + " iterations (residual " +
-                             std::to_string(r.residual_norm) + " N)");
+                             scientific(r.residual_norm) + " N)");
   solution.x = r.x;
   solution.newton_iterations = r.iterations;
   solution.surface_displacement =

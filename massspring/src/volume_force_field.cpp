@@ -283,6 +283,51 @@ VolumeElements tetrahedron_elements(const Eigen::MatrixX3d& rest_positions,
   return elements;
 }
 
+int remove_degenerate_elements(VolumeElements& elements, const Eigen::VectorXd& rest,
+                               double min_shape) {
+  const int n = elements.num_elements();
+  if (n == 0) return 0;
+  const double orientation = elements.rest_volume.sum() >= 0.0 ? 1.0 : -1.0;
+  std::vector<char> keep(n, 0);
+  for (int e = 0; e < n; ++e) {
+    double longest = 0.0;
+    for (int t = elements.tet_start[e]; t < elements.tet_start[e + 1]; ++t)
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          longest = std::max(longest, (rest.segment<3>(3 * elements.tets(t, i)) -
+                                       rest.segment<3>(3 * elements.tets(t, j)))
+                                          .norm());
+    const double v = orientation * elements.rest_volume[e];
+    keep[e] = v > 0.0 && v >= min_shape * longest * longest * longest;
+  }
+  VolumeElements kept;
+  std::vector<int> tets;
+  std::vector<int> kept_elements;
+  for (int e = 0; e < n; ++e) {
+    if (!keep[e]) continue;
+    kept_elements.push_back(e);
+    for (int t = elements.tet_start[e]; t < elements.tet_start[e + 1]; ++t)
+      tets.push_back(t);
+    kept.tet_start.push_back(static_cast<int>(tets.size()));
+  }
+  const int removed = n - kept.num_elements();
+  if (removed == 0) return 0;
+  kept.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
+  kept.tet_weight.resize(static_cast<Eigen::Index>(tets.size()));
+  for (std::size_t k = 0; k < tets.size(); ++k) {
+    kept.tets.row(static_cast<Eigen::Index>(k)) = elements.tets.row(tets[k]);
+    kept.tet_weight[static_cast<Eigen::Index>(k)] = elements.tet_weight[tets[k]];
+  }
+  kept.rest_volume.resize(kept.num_elements());
+  kept.modulus.resize(kept.num_elements());
+  for (int k = 0; k < kept.num_elements(); ++k) {
+    kept.rest_volume[k] = elements.rest_volume[kept_elements[k]];
+    kept.modulus[k] = elements.modulus[kept_elements[k]];
+  }
+  elements = std::move(kept);
+  return removed;
+}
+
 double volume_modulus_for(double youngs_modulus, double poisson_ratio) {
   auto lambda = [&](double nu) { return youngs_modulus * nu / ((1 + nu) * (1 - 2 * nu)); };
   return poisson_ratio <= 0.25 ? 0.0 : lambda(poisson_ratio) - lambda(0.25);

@@ -76,6 +76,9 @@ TEST(Sanity, VolumePreservationBringsTheNetworksCloserAtNuPointFourFive) {
     const auto j = nlohmann::json::parse(read_text(out / "summary.json"));
     for (const auto& v : j["variants"])
       by_setting[setting][v["name"].get<std::string>()] = v;
+    const std::string said = setting == "true" ? "volume preservation: tet_edges (mean κ 8110"
+                                               : "volume preservation: off";
+    EXPECT_NE(read_text(out / "report.md").find(said), std::string::npos) << said;
   }
   const auto& off = by_setting["false"];
   const auto& on = by_setting["true"];

@@ -152,6 +152,54 @@ TEST(VolumeForceField, RejectsBadElements) {
   EXPECT_THROW(model.set_volume(VolumeForceField(nv, VolumeElements{})), ModelError);
 }
 
+TEST(VolumeForceField, InvertedAndFlatPrismsOfAFoldedTierAreRemoved) {
+  const auto mesh = icosphere(1, 0.05);
+  SpringNetwork network = build_three_tier(mesh.vertices, mesh.triangles, ThreeTierOptions{});
+  const int nv = static_cast<int>(mesh.vertices.rows());
+  // Fold tier 2 over triangle 0: its three tier-2 copies pushed beyond the surface invert the 1-2
+  // prism there. Flatten the 2-3 prism of triangle 1: its tier-3 copies onto tier 2.
+  for (int k = 0; k < 3; ++k) {
+    const int a = mesh.triangles(0, k), b = mesh.triangles(1, k);
+    network.rest_positions.row(nv + a) = 1.1 * network.rest_positions.row(a);
+    network.rest_positions.row(2 * nv + b) = network.rest_positions.row(nv + b);
+  }
+  VolumeElements prisms = tier_prisms(network.rest_positions, mesh.triangles, nv, 3, 1.0);
+  const int before = prisms.num_elements();
+  const double inverted = prisms.rest_volume[0],
+               flat = prisms.rest_volume[mesh.triangles.rows() + 1];
+  EXPECT_LT(inverted * prisms.rest_volume.sum(), 0.0);
+  EXPECT_NEAR(flat, 0.0, 1e-15);
+  const int removed = remove_degenerate_elements(prisms, flatten(network.rest_positions), 1e-3);
+  EXPECT_GE(removed, 2);
+  EXPECT_EQ(prisms.num_elements(), before - removed);
+  EXPECT_LT(removed, before / 4);
+  const double sign = prisms.rest_volume[0] > 0 ? 1.0 : -1.0;
+  for (int e = 0; e < prisms.num_elements(); ++e)
+    EXPECT_GT(sign * prisms.rest_volume[e], 0.0) << e;
+  // What is left is still a valid field, and a second pass removes nothing.
+  EXPECT_NO_THROW(VolumeForceField(network.num_nodes(), prisms));
+  EXPECT_EQ(remove_degenerate_elements(prisms, flatten(network.rest_positions), 1e-3), 0);
+}
+
+TEST(VolumeForceField, SmallButWellShapedTetrahedraOfAGradedMeshAreKept) {
+  // The same corner tetrahedron at 1 cm and at 10 µm, and a sliver (apex 1e-5 of its size off the
+  // base plane): only the sliver is flat.
+  Eigen::MatrixX3d p(12, 3);
+  p << 0, 0, 0, 0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.01,  //
+      0, 0, 0, 1e-5, 0, 0, 0, 1e-5, 0, 0, 0, 1e-5,   //
+      0, 0, 0, 0.01, 0, 0, 0, 0.01, 0, 0.005, 0.005, 1e-7;
+  for (int i = 4; i < 8; ++i)
+    p.row(i) += Eigen::RowVector3d(0.1, 0, 0);
+  for (int i = 8; i < 12; ++i)
+    p.row(i) += Eigen::RowVector3d(0.2, 0, 0);
+  Eigen::MatrixX4i tets(3, 4);
+  tets << 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11;
+  VolumeElements elements = tetrahedron_elements(p, tets, 1.0);
+  EXPECT_EQ(remove_degenerate_elements(elements, flatten(p), 1e-3), 1);
+  ASSERT_EQ(elements.num_elements(), 2);
+  EXPECT_NEAR(elements.rest_volume[1], 1e-15 / 6.0, 1e-20);  // the small one is still there
+}
+
 TEST(VolumeForceField, FastSteppersRefuseAModelWhoseVolumeTheyWouldDrop) {
   const SpringNetwork network = three_tier_sphere(1);
   const int nv = static_cast<int>(network.surface_nodes.size());

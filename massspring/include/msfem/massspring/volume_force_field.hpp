@@ -69,6 +69,15 @@ VolumeElements tier_prisms(const Eigen::MatrixX3d& rest_positions,
 VolumeElements tetrahedron_elements(const Eigen::MatrixX3d& rest_positions,
                                     const Eigen::MatrixX4i& tets, double modulus);
 
+/// Removes the elements that cannot keep a volume at rest: those whose signed rest volume is
+/// against the majority's orientation (a folded tier: an inner copy of a concave surface crosses
+/// the outer one) or flat, |V⁰| < `min_shape` × (longest edge)³ (a regular tetrahedron has 0.118;
+/// κ/|V⁰| would make a sliver far stiffer than anything around it, and Newton stalled on the
+/// brain's folded tiers). Scale-free, so a graded mesh keeps its small elements. `rest` is
+/// node-major (flatten of the rest positions). Returns how many were removed.
+int remove_degenerate_elements(VolumeElements& elements, const Eigen::VectorXd& rest,
+                               double min_shape);
+
 /// κ to add to a central-spring network so that it has the bulk response of an isotropic solid
 /// of Young's modulus E and Poisson's ratio ν: λ(E, ν) − λ(E, 1/4) (0 for ν ≤ 1/4).
 double volume_modulus_for(double youngs_modulus, double poisson_ratio);
