@@ -136,7 +136,7 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
       removed > 0)
     variant.warnings.push_back(
         "volume preservation: " + std::to_string(removed) + " of " + std::to_string(all) +
-        " volume elements are inverted or nearly flat at rest (folded tiers) and are left out");
+        " volume elements are inverted or flat at rest (folded tiers, slivers) and are left out");
   if (elements.num_elements() > 0)
     model.set_volume(ms::VolumeForceField(model.num_nodes(), std::move(elements)));
 }
