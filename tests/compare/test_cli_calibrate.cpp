@@ -80,6 +80,37 @@ TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
   }
 }
 
+// The volume group through the whole chain: fitted, written to calibrated.prm as a group scale
+// beside `volume preservation = true`, and built again by `msfem run` with the fitted modulus.
+TEST(CliCalibrate, TheFittedVolumeModulusIsWhatCalibratedPrmBuilds) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "cal";
+  const auto r = run_msfem("calibrate " + small_case +
+                           " --quiet --json --fit tier1_edges,volume --set 'material/poisson "
+                           "ratio=0.45' --set 'mass spring/volume preservation=true' --out " +
+                           out.string() + " --set output/directory=" + (tmp / "runs").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["coefficients"].size(), 2u);
+  const auto& volume = j["coefficients"][1];
+  EXPECT_EQ(volume["group"], "volume");
+  EXPECT_EQ(volume["unit"], "Pa");
+  EXPECT_NEAR(volume["start_modulus_Pa"].get<double>(), 3000.0 * (0.45 / 0.145 - 0.4), 1e-6);
+  const auto run_dir = tmp / "run";
+  const auto run = run_msfem("run " + (out / "calibrated.prm").string() +
+                             " --quiet --no-timing --no-curve --out " + run_dir.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto summary = nlohmann::json::parse(read_text(run_dir / "summary.json"));
+  bool found = false;
+  for (const auto& v : summary["variants"]) {
+    if (v["name"] != "three_tier") continue;
+    found = true;
+    const double built = v["parameters"]["volume_preservation"]["mean_modulus_pa"];
+    EXPECT_NEAR(built / volume["fitted_modulus_Pa"].get<double>(), 1.0, 1e-6);
+  }
+  EXPECT_TRUE(found);
+}
+
 TEST(CliCalibrate, BadInputIsOneLineAndLeavesNoResultFolder) {
   TemporaryDirectory tmp;
   const std::vector<std::pair<std::string, std::string>> cases = {
