@@ -203,9 +203,12 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   const double volume_start_factor = volume_index >= 0 && !options.start_factors.empty()
                                          ? options.start_factors[volume_index]
                                          : 1.0;
+  // The volume modulus is scaled uniformly: one factor over the case's, the start's times exp θ.
+  auto volume_factor_at = [&](const std::vector<double>& theta) {
+    return volume_start_factor * (volume_index >= 0 ? std::exp(theta[volume_index]) : 1.0);
+  };
   auto modulus_at = [&](const std::vector<double>& theta) {
-    return Eigen::VectorXd(case_modulus * volume_start_factor *
-                           (volume_index >= 0 ? std::exp(theta[volume_index]) : 1.0));
+    return Eigen::VectorXd(case_modulus * volume_factor_at(theta));
   };
   // The case's stiffness (analytic × its group scales) and the start (× the start factors).
   const Eigen::VectorXd case_stiffness = network.stiffness;
@@ -243,8 +246,7 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
     std::vector<double> weights(n + 1, 1.0);
     for (int g = 0; g < n; ++g)
       weights[g + 1] = std::exp(theta[g]);
-    if (base.model->volume())
-      weights.push_back(modulus_at(theta).sum() / std::max(case_modulus.sum(), 1e-300));
+    if (base.model->volume()) weights.push_back(volume_factor_at(theta));
     std::vector<LoadErrors> errors;
     for (std::size_t i = 0; i < references.size(); ++i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
@@ -316,7 +318,7 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
       f.springs = static_cast<int>(case_modulus.size());
       k_case = case_modulus.sum();
       k_start = k_case * volume_start_factor;
-      k_fit = modulus_at(best_theta).sum();
+      k_fit = k_case * volume_factor_at(best_theta);
     }
     for (int s = 0; s < network.num_springs() && g != volume_index; ++s)
       if (network.spring_group[s] == group_id[g]) {

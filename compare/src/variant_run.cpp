@@ -132,8 +132,7 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
   const int all = elements.num_elements();
   // The brain's offset inner tiers fold where the surface is concave: such prisms are inverted or
   // flat at rest, and with them Newton stalled (residual ~1e-7 N after 100 iterations).
-  if (const int removed = ms::remove_degenerate_elements(elements, model.rest_state(), 1e-3);
-      removed > 0)
+  if (const int removed = ms::remove_degenerate_elements(elements, rest, 1e-3); removed > 0)
     variant.warnings.push_back(
         "volume preservation: " + std::to_string(removed) + " of " + std::to_string(all) +
         " volume elements are inverted or flat at rest (folded tiers, slivers) and are left out");

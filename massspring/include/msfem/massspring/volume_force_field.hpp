@@ -73,9 +73,9 @@ VolumeElements tetrahedron_elements(const Eigen::MatrixX3d& rest_positions,
 /// against the majority's orientation (a folded tier: an inner copy of a concave surface crosses
 /// the outer one) or flat, |V⁰| < `min_shape` × (longest edge)³ (a regular tetrahedron has 0.118;
 /// κ/|V⁰| would make a sliver far stiffer than anything around it, and Newton stalled on the
-/// brain's folded tiers). Scale-free, so a graded mesh keeps its small elements. `rest` is
-/// node-major (flatten of the rest positions). Returns how many were removed.
-int remove_degenerate_elements(VolumeElements& elements, const Eigen::VectorXd& rest,
+/// brain's folded tiers). Scale-free, so a graded mesh keeps its small elements. Returns how many
+/// were removed.
+int remove_degenerate_elements(VolumeElements& elements, const Eigen::MatrixX3d& rest_positions,
                                double min_shape);
 
 /// κ to add to a central-spring network so that it has the bulk response of an isotropic solid
