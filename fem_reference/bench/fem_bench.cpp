@@ -1,6 +1,7 @@
 // fem_reference_bench: the FEM reference's stages (Gmsh mesh, set-up, assembly, solve), iterations
-// and peak memory on the two problems of issue C's speed targets, serially or under mpirun. The
-// parallel efficiency from 1 to N ranks is the ratio of two such runs, taken back to back.
+// and peak memory on its two speed benchmarks (the P1 sphere, the P2 brain; results/BENCHMARKS.md),
+// serially or under mpirun. The parallel efficiency from 1 to N ranks is the ratio of two such
+// runs, taken back to back.
 //
 //   fem_reference_bench sphere|brain [--degree 1|2] [--cell-size M] [--level L] [--algorithm 1|10]
 //                       [--relocate 0|1]

@@ -1,4 +1,4 @@
-// The harness's sanity claims that could fail (issue D), on the shipped sphere cases:
+// The harness's sanity claims that could fail, on the shipped sphere cases:
 // - on the ν = 1/4 twin, where a spring network obeys the Cauchy relations, the volumetric
 //   tet_edges network is closer to the FEM than one surface layer at every sweep resolution;
 // - the FEM's and the spring models' reaction forces grow with the tool's depth.

@@ -38,7 +38,7 @@ struct LoadErrors {
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
   /// Surface nodes the tool holds in the spring model at this load. One node's force grows about
   /// linearly with depth while the FEM's resolved contact grows faster: no stiffness fits every
-  /// depth then (results/BENCHMARKS.md, issue E, session 6).
+  /// depth then (docs/calibration.md, "When the surface cannot resolve the tool").
   int tool_patch_nodes = 0;
 };
 

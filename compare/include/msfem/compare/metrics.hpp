@@ -1,7 +1,6 @@
 #pragma once
 // Displacement and force errors of a mass-spring model against the FEM reference, as defined in
-// docs/metrics.md (DESIGN's metrics): over the surface vertices not prescribed by a support or
-// load.
+// docs/harness.md ("Metrics"): over the surface vertices not prescribed by a support or load.
 
 #include <Eigen/Core>
 #include <vector>

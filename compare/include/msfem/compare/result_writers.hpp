@@ -1,8 +1,8 @@
 #pragma once
-// The result files of a comparison run (results/<case>/<run>/): meshes with their fields for
-// ParaView (surface.vtu, fem.vtu, a .pvd collection of them) and every field in one HDF5 file
-// (fields.h5) for scripts and for `msfem regress`. All lengths are metres. Every writer writes
-// through write_file_atomically: a failure leaves no half-written file behind.
+// The result files of a comparison run (results/runs/<case>-<time>/ or --out DIR): meshes with
+// their fields for ParaView (surface_<variant>.vtu, fem.vtu, .pvd collections of them) and every
+// field in one HDF5 file (fields.h5) for scripts and for `msfem regress`. All lengths are metres.
+// Every writer writes through write_file_atomically: a failure leaves no half-written file behind.
 
 #include <Eigen/Core>
 #include <filesystem>

@@ -90,9 +90,10 @@ struct SolveStatistics {
 /// Static linear elasticity on a tetrahedral mesh with deal.II (simplex P1/P2) and PETSc, in the
 /// order of deal.II's step-8: setup_system, assemble_system, solve, then queries. All ranks of
 /// MPI_COMM_WORLD must construct and run it together (a parallel::shared::Triangulation
-/// partitioned by METIS); the mesh of rank 0 is used (broadcast; other ranks may pass an empty
-/// one), and every query returns the same complete answer on every rank. MPI and PETSc are
-/// initialised on first use if the program has not done so (and finalised at exit).
+/// partitioned by coordinate bisection, partition_cells); the mesh of rank 0 is used (broadcast;
+/// other ranks may pass an empty one), and every query returns the same complete answer on every
+/// rank. MPI and PETSc are initialised on first use if the program has not done so (and finalised
+/// at exit).
 ///
 /// Throws std::invalid_argument for bad input (E <= 0, nu outside (-1, 0.5), a degree other than 1
 /// or 2, a support or traction region that catches nothing), FemError when there is no support
