@@ -7,6 +7,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <regex>
@@ -15,6 +16,7 @@
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface_generators.hpp"
+#include "msfem/massspring/integrators.hpp"
 
 namespace msfem::cases {
 namespace {
@@ -161,12 +163,20 @@ void declare_fem_timing_output(ParameterHandler& prm) {
       "whose answer depends on the mesh and the degree.");
   prm.declare_entry("tool cell size", "0", Patterns::Double(0),
                     "Edge length (m) of the refined surface at the tool; 0: tool radius / 3.");
+  prm.declare_entry(
+      "error estimate", "auto", Patterns::Selection("auto|refine|degree|none"),
+      "The reference's own discretisation error, from a second solve of each tool load: refine "
+      "(the same degree on the mesh with every tetrahedron split into eight), degree (degree 2 "
+      "on the same mesh; needs degree = 1), none. auto: degree at degree 1; refine at degree 2 "
+      "for every load if that costs at most 3x the reference's own solves (or the refined "
+      "problem is small), else for as many loads as fit in that budget; none where the refined "
+      "problem would not fit in memory. Variants within 3x of it are flagged 'not resolved by "
+      "this reference'.");
   prm.leave_subsection();
   prm.enter_subsection("timing");
-  prm.declare_entry(
-      "integrator", "symplectic_euler",
-      Patterns::Selection("explicit_euler|symplectic_euler|verlet|rk4|implicit_euler"),
-      "Integrator whose steps are timed.");
+  prm.declare_entry("integrator", "symplectic_euler",
+                    Patterns::Selection(massspring::integrator_names("|")),
+                    "Integrator whose steps are timed.");
   prm.declare_entry("dt", "0", Patterns::Double(0),
                     "Time step (s); 0: half the estimated stable step of each variant.");
   prm.declare_entry("steps", "2000", Patterns::Integer(1, 100000000), "Dynamic steps timed.");
@@ -365,7 +375,12 @@ CaseParameters extract(ParameterHandler& prm) {
            prm.get("solver"),
            prm.get_double("relative tolerance"),
            prm.get_bool("refine at tool"),
-           prm.get_double("tool cell size")};
+           prm.get_double("tool cell size"),
+           error_estimate_from_name(prm.get("error estimate"))};
+  if (c.fem.error_estimate == FemParameters::ErrorEstimate::degree && c.fem.degree != 1)
+    throw InputError(
+        "fem/error estimate = degree needs fem/degree = 1 (deal.II has no cubic tetrahedron to "
+        "go above degree 2); use refine");
   prm.leave_subsection();
   prm.enter_subsection("timing");
   c.timing = {prm.get("integrator"), prm.get_double("dt"),
@@ -408,6 +423,27 @@ void load_case(const std::filesystem::path& file, const std::vector<std::string>
 }
 
 }  // namespace
+
+namespace {
+constexpr std::array<std::pair<FemParameters::ErrorEstimate, const char*>, 4> error_estimates = {{
+    {FemParameters::ErrorEstimate::automatic, "auto"},
+    {FemParameters::ErrorEstimate::refine, "refine"},
+    {FemParameters::ErrorEstimate::degree, "degree"},
+    {FemParameters::ErrorEstimate::none, "none"},
+}};
+}  // namespace
+
+const char* error_estimate_name(FemParameters::ErrorEstimate method) {
+  for (const auto& [m, name] : error_estimates)
+    if (m == method) return name;
+  return "auto";
+}
+
+FemParameters::ErrorEstimate error_estimate_from_name(const std::string& name) {
+  for (const auto& [m, n] : error_estimates)
+    if (name == n) return m;
+  throw InputError("fem/error estimate: unknown method '" + name + "'");
+}
 
 std::string ToolLoad::label() const {
   std::ostringstream out;

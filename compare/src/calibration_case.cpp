@@ -127,7 +127,7 @@ void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& tr
       r.tool_force = s.tool_force;
       if (request.fem_cache_directory)
         store_fem_cache(*request.fem_cache_directory, load_key(problem_key, all[i]),
-                        {c.mesh, s, {}, {}});
+                        {c.mesh, s, {}, {}, {}});
     }
     const std::vector<bool> prescribed = prescribed_surface_vertices(problem, r.tool);
     for (std::size_t v = 0; v < prescribed.size(); ++v)

@@ -90,6 +90,54 @@ std::vector<int> unprescribed_vertices(const Problem& problem,
   return free;
 }
 
+// How many solves the case's reference takes as `msfem run` makes it: each tool position, and the
+// force-depth curve's depths other than the case's. Independent of what one command skips, so
+// that the error estimate's method (and the cache entry) is the same for every command.
+int reference_solve_count(const Problem& problem) {
+  if (problem.tools.empty()) return 1;
+  const auto& tool = problem.parameters.loads.tool;
+  const auto depths = curve_depths(tool);
+  return static_cast<int>(problem.tools.size()) +
+         static_cast<int>(std::count_if(depths.begin(), depths.end(),
+                                        [&](double d) { return d != tool.depth_m; }));
+}
+
+std::vector<ForceDepthPoint> fem_force_depth(const Problem& problem,
+                                             const fem_reference::VolumeMesh& mesh,
+                                             const FemSolution& at_depth_solution,
+                                             const std::optional<ToolPlacement>& tool,
+                                             const std::vector<double>& depths,
+                                             const Progress& progress) {
+  std::vector<ForceDepthPoint> curve;
+  const auto start = Clock::now();
+  for (std::size_t i = 0; i < depths.size(); ++i) {
+    // The run's own depth is already solved.
+    const Eigen::Vector3d force =
+        depths[i] == tool->depth ? at_depth_solution.tool_force
+                                 : solve_fem(problem, mesh, at_depth(*tool, depths[i])).tool_force;
+    curve.push_back({depths[i], force, std::nullopt});
+    progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
+                     static_cast<int>(depths.size()), seconds_since(start));
+  }
+  return curve;
+}
+
+FemErrorEstimate estimate_run_error(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                                    const ErrorEstimatePlan& plan, const FemSolution& first,
+                                    const std::vector<FemSolution>& others) {
+  std::vector<const FemSolution*> references = {&first};
+  std::vector<std::optional<ToolPlacement>> tools = {
+      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front())};
+  for (std::size_t t = 0; t < others.size(); ++t) {
+    references.push_back(&others[t]);
+    tools.emplace_back(problem.tools[t + 1]);
+  }
+  std::vector<std::vector<int>> compared;
+  for (const auto& tool : tools)
+    compared.push_back(unprescribed_vertices(problem, tool));
+  return estimate_fem_error(problem, mesh, plan, references, compared, tools);
+}
+
 // The variant's equilibrium with `tool` at its depth. With a path, a quasi-static loading path,
 // each depth started from the last, as a tool pressed in steps is: a network with several
 // equilibria (one that buckles under the tool) then stays on the branch a simulator would follow.
@@ -131,6 +179,13 @@ ToolLoadVariant compare_at_tool(const Problem& problem, const BuiltVariant& buil
   o.inverted_elements = inverted_tetrahedra(built, s.x);
   o.force_depth_monotone = force_grows_with_depth(curve, tool);
   o.force_depth = std::move(curve);
+  const std::vector<int> patch = patch_vertices(problem);
+  if (!patch.empty()) {
+    const Eigen::Vector3d reference = mean_displacement(fem.surface_displacement, patch);
+    o.patch_mean_displacement = mean_displacement(s.surface_displacement, patch);
+    o.patch_displacement_rel_error =
+        (*o.patch_mean_displacement - reference).norm() / reference.norm();
+  }
   return o;
 }
 
@@ -171,6 +226,65 @@ void press_other_tools(CaseRun& run, BuiltVariant& built, const std::vector<doub
     if (e) std::rethrow_exception(e);
   for (int k = 0; k < n; ++k)
     run.other_tools[k].variants.push_back(std::move(results[k]));
+}
+
+// Solves (or reads from the cache) the FEM at every load of the run, its force-depth curve and its
+// own error estimate, and fills in each load's compared vertices.
+void reference_solutions(CaseRun& run, const RunSettings& settings,
+                         const std::vector<double>& depths, int other_tools,
+                         const Progress& progress) {
+  const Problem& problem = run.problem;
+  const std::optional<ToolPlacement> tool =
+      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
+  run.fem_cache_key = fem_cache_key(problem, depths, other_tools > 0);
+  std::optional<FemCacheEntry> cached;
+  if (settings.fem_cache_directory)
+    cached = load_fem_cache(*settings.fem_cache_directory, run.fem_cache_key);
+  if (cached && static_cast<int>(cached->other_tools.size()) != other_tools) cached.reset();
+  std::vector<FemSolution> other_fem;
+  if (cached) {
+    progress.stage("FEM reference from the cache (" +
+                   (*settings.fem_cache_directory / (run.fem_cache_key + ".cbor")).string() +
+                   "): nothing it depends on changed");
+    run.mesh = std::move(cached->mesh);
+    run.fem = std::move(cached->solution);
+    run.fem_force_depth = std::move(cached->force_depth);
+    other_fem = std::move(cached->other_tools);
+    run.fem_error = std::move(cached->error_estimate);
+    run.fem_from_cache = true;
+  } else {
+    progress.stage("meshing the volume (Gmsh) for the FEM reference");
+    // One mesh for every load, refined at each tool it presses with.
+    run.mesh = other_tools > 0 ? mesh_problem(problem, problem.tools) : mesh_problem(problem);
+    // Decided (and refused, for a method that cannot run) before the first solve.
+    const ErrorEstimatePlan plan =
+        plan_error_estimate(problem, run.mesh, reference_solve_count(problem), 1 + other_tools);
+    progress.stage("solving the FEM reference (P" + std::to_string(problem.parameters.fem.degree) +
+                   ", " + std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
+    run.fem = solve_fem(problem, run.mesh, tool);
+    run.fem_force_depth = fem_force_depth(problem, run.mesh, run.fem, tool, depths, progress);
+    const auto others_start = Clock::now();
+    for (int t = 1; t <= other_tools; ++t) {
+      other_fem.push_back(solve_fem(problem, run.mesh, problem.tools[t]));
+      progress.advance("FEM at the other tool positions", t, other_tools,
+                       seconds_since(others_start));
+    }
+    if (plan.method != "none")
+      progress.stage("estimating the reference's own error (" + plan.note + ")");
+    run.fem_error = estimate_run_error(problem, run.mesh, plan, run.fem, other_fem);
+    if (settings.fem_cache_directory)
+      store_fem_cache(*settings.fem_cache_directory, run.fem_cache_key,
+                      {run.mesh, run.fem, run.fem_force_depth, other_fem, run.fem_error});
+  }
+  if (run.mesh.num_tetrahedra() > 0)
+    run.worst_cell_quality = fem_reference::cell_quality(run.mesh).minCoeff();
+  for (int t = 1; t <= other_tools; ++t) {
+    ToolLoad load;
+    load.tool = t;
+    load.fem = std::move(other_fem[t - 1]);
+    load.compared_vertices = unprescribed_vertices(problem, problem.tools[t]);
+    run.other_tools.push_back(std::move(load));
+  }
 }
 
 }  // namespace
@@ -241,58 +355,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   if (tool && settings.force_depth_curve) depths = curve_depths(parameters.loads.tool);
   const int other_tools =
       settings.all_tools ? std::max(0, static_cast<int>(problem.tools.size()) - 1) : 0;
-  run.fem_cache_key = fem_cache_key(problem, depths, other_tools > 0);
-  std::optional<FemCacheEntry> cached;
-  if (settings.fem_cache_directory)
-    cached = load_fem_cache(*settings.fem_cache_directory, run.fem_cache_key);
-  if (cached && static_cast<int>(cached->other_tools.size()) != other_tools) cached.reset();
-  std::vector<FemSolution> other_fem;
-  if (cached) {
-    progress.stage("FEM reference from the cache (" +
-                   (*settings.fem_cache_directory / (run.fem_cache_key + ".cbor")).string() +
-                   "): nothing it depends on changed");
-    run.mesh = std::move(cached->mesh);
-    run.fem = std::move(cached->solution);
-    run.fem_force_depth = std::move(cached->force_depth);
-    other_fem = std::move(cached->other_tools);
-    run.fem_from_cache = true;
-  } else {
-    progress.stage("meshing the volume (Gmsh) for the FEM reference");
-    // One mesh for every load, refined at each tool it presses with.
-    run.mesh = other_tools > 0 ? mesh_problem(problem, problem.tools) : mesh_problem(problem);
-    progress.stage("solving the FEM reference (P" + std::to_string(parameters.fem.degree) + ", " +
-                   std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
-    run.fem = solve_fem(problem, run.mesh, tool);
-    const auto curve_start = Clock::now();
-    for (std::size_t i = 0; i < depths.size(); ++i) {
-      // The run's own depth is already solved.
-      const Eigen::Vector3d force =
-          depths[i] == tool->depth
-              ? run.fem.tool_force
-              : solve_fem(problem, run.mesh, at_depth(*tool, depths[i])).tool_force;
-      run.fem_force_depth.push_back({depths[i], force, std::nullopt});
-      progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
-                       static_cast<int>(depths.size()), seconds_since(curve_start));
-    }
-    const auto others_start = Clock::now();
-    for (int t = 1; t <= other_tools; ++t) {
-      other_fem.push_back(solve_fem(problem, run.mesh, problem.tools[t]));
-      progress.advance("FEM at the other tool positions", t, other_tools,
-                       seconds_since(others_start));
-    }
-    if (settings.fem_cache_directory)
-      store_fem_cache(*settings.fem_cache_directory, run.fem_cache_key,
-                      {run.mesh, run.fem, run.fem_force_depth, other_fem});
-  }
-  if (run.mesh.num_tetrahedra() > 0)
-    run.worst_cell_quality = fem_reference::cell_quality(run.mesh).minCoeff();
-  for (int t = 1; t <= other_tools; ++t) {
-    ToolLoad load;
-    load.tool = t;
-    load.fem = std::move(other_fem[t - 1]);
-    load.compared_vertices = unprescribed_vertices(problem, problem.tools[t]);
-    run.other_tools.push_back(std::move(load));
-  }
+  reference_solutions(run, settings, depths, other_tools, progress);
 
   run.fem_force_depth_monotone = force_grows_with_depth(run.fem_force_depth, tool);
 
@@ -318,6 +381,13 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
                                                          run.fem, run.compared_vertices, tool);
       if (r.force_depth_monotone == false)
         r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
+      std::string unresolved;
+      for (const std::string& metric : unresolved_metrics(run, r))
+        unresolved += (unresolved.empty() ? "" : ", ") + metric;
+      if (!unresolved.empty())
+        r.warnings.push_back("not resolved by this reference: " + unresolved +
+                             " within 3x of the FEM's own estimated error (a finer fem/cell "
+                             "size resolves it)");
       r.newton_iterations = s.newton_iterations;
       r.equilibrium = s.x;
       r.surface_displacement = s.surface_displacement;
@@ -344,6 +414,22 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
                              ": " + run.failed_variants[0].second);
   run.wall_time_s = seconds_since(start);
   return run;
+}
+
+std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
+                                            int load) {
+  std::vector<std::string> metrics;
+  if (load >= static_cast<int>(run.fem_error.loads.size())) return metrics;
+  const LoadErrorEstimate& estimate = run.fem_error.loads[static_cast<std::size_t>(load)];
+  if (within_reference_error(variant.errors.all.rel_l2_error, estimate.rel_l2_error))
+    metrics.emplace_back("rel_l2_error");
+  if (!run.problem.tools.empty() &&
+      within_reference_error(variant.reaction_force_rel_error, estimate.force_rel_error))
+    metrics.emplace_back("reaction_force_rel_error");
+  if (variant.patch_displacement_rel_error &&
+      within_reference_error(*variant.patch_displacement_rel_error, estimate.force_rel_error))
+    metrics.emplace_back("patch_displacement_rel_error");
+  return metrics;
 }
 
 std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& v) {

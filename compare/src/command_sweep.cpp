@@ -10,6 +10,8 @@
 #include "msfem/compare/options.hpp"
 #include "msfem/compare/plots.hpp"
 #include "msfem/compare/sweep.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/integrators.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -52,9 +54,12 @@ int sweep_command(const Arguments& args) {
   if (const auto r = opt.value("resolutions")) settings.resolutions = integers("resolutions", *r);
   if (const auto i = opt.value("integrators")) settings.integrators = split(*i);
   for (const auto& name : settings.integrators)
-    if (name != "explicit_euler" && name != "symplectic_euler" && name != "central_difference" &&
-        name != "rk4" && name != "implicit_euler")
-      throw std::invalid_argument("option --integrators: unknown integrator '" + name + "'");
+    try {
+      massspring::parse_integrator(name);
+    } catch (const massspring::ModelError&) {
+      throw std::invalid_argument("option --integrators: unknown integrator '" + name + "' (" +
+                                  massspring::integrator_names(", ") + ")");
+    }
 
   const std::filesystem::path final_dir = opt.value("out")
                                               ? std::filesystem::path(*opt.value("out"))

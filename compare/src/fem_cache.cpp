@@ -12,7 +12,7 @@ namespace msfem::compare {
 namespace {
 
 // Bump when the FEM's formulation or the entry layout changes: old entries then miss.
-constexpr const char* cache_version = "msfem-fem-cache-5";
+constexpr const char* cache_version = "msfem-fem-cache-6";
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
   return {{"rows", m.rows()},
@@ -32,6 +32,35 @@ nlohmann::json vec(const Eigen::Vector3d& v) {
 }
 Eigen::Vector3d vec_from(const nlohmann::json& j) {
   return Eigen::Vector3d(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>());
+}
+
+nlohmann::json optional_number(const std::optional<double>& x) {
+  return x ? nlohmann::json(*x) : nlohmann::json();
+}
+std::optional<double> optional_from(const nlohmann::json& j) {
+  return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
+}
+
+nlohmann::json estimate_json(const FemErrorEstimate& e) {
+  nlohmann::json loads = nlohmann::json::array();
+  for (const auto& l : e.loads)
+    loads.push_back({optional_number(l.rel_l2_error), optional_number(l.force_rel_error)});
+  return {{"method", e.method},
+          {"note", e.note},
+          {"dofs", e.dofs},
+          {"time_s", e.time_s},
+          {"loads", loads}};
+}
+
+FemErrorEstimate estimate_from(const nlohmann::json& j) {
+  FemErrorEstimate e;
+  e.method = j.at("method");
+  e.note = j.at("note");
+  e.dofs = j.at("dofs");
+  e.time_s = j.at("time_s");
+  for (const auto& l : j.at("loads"))
+    e.loads.push_back({optional_from(l.at(0)), optional_from(l.at(1))});
+  return e;
 }
 
 }  // namespace
@@ -70,6 +99,7 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
   h.number(p.fem.relative_tolerance);
   h.number(p.fem.refine_at_tool);
   h.number(p.fem.tool_cell_size_m);
+  h.text(cases::error_estimate_name(p.fem.error_estimate));
   for (double d : curve_depths)
     h.number(d);
   // Keys of entries without them stay what they were, so existing entries remain valid.
@@ -109,6 +139,7 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     s.statistics.solve_time_s = st.at("solve_time_s");
     for (const auto& p : j.at("force_depth"))
       e.force_depth.push_back({p.at("depth_m"), vec_from(p.at("force_N")), std::nullopt});
+    e.error_estimate = estimate_from(j.at("error_estimate"));
     if (j.contains("other_tools"))
       for (const auto& o : j.at("other_tools")) {
         FemSolution t;
@@ -154,7 +185,8 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                         {"setup_time_s", st.setup_time_s},
                         {"assemble_time_s", st.assemble_time_s},
                         {"solve_time_s", st.solve_time_s}}},
-                      {"force_depth", fd}};
+                      {"force_depth", fd},
+                      {"error_estimate", estimate_json(e.error_estimate)}};
   if (!e.other_tools.empty()) {
     j["other_tools"] = nlohmann::json::array();
     for (const auto& t : e.other_tools)

@@ -77,6 +77,25 @@ ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s
   return t;
 }
 
+// A patch force that pulls only fixed nodes moves nothing in either model: the comparison would
+// divide by a reference that does not move.
+void check_patch_force(const Problem& problem) {
+  const auto& p = problem.parameters;
+  const std::vector<int> patch = patch_vertices(problem);
+  const auto free = std::count_if(patch.begin(), patch.end(), [&](int v) {
+    return !problem.fixed_region(problem.surface.vertices.row(v).transpose());
+  });
+  if (free == 0) {
+    const Eigen::Vector3d& d = p.loads.patch_force.direction;
+    throw cases::InputError(
+        p.file.string() + ": loads/patch force/direction (" + std::to_string(d.x()) + ", " +
+        std::to_string(d.y()) + ", " + std::to_string(d.z()) + "): all " +
+        std::to_string(patch.size()) +
+        " surface vertices of the patch lie in the fixed region (support/fixed region): the "
+        "force would move nothing; point the patch at a free part of the surface");
+  }
+}
+
 }  // namespace
 
 fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
@@ -102,6 +121,26 @@ int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centro
   Eigen::Index best = 0;
   ((surface.vertices.rowwise() - centroid.transpose()) * direction).maxCoeff(&best);
   return static_cast<int>(best);
+}
+
+std::vector<int> patch_vertices(const Problem& problem) {
+  const auto& patch = problem.parameters.loads.patch_force;
+  std::vector<int> vertices;
+  if (!patch.enabled) return vertices;
+  const auto& s = problem.surface;
+  const int center = farthest_vertex(s, problem.centroid, patch.direction);
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    if ((s.vertices.row(v) - s.vertices.row(center)).norm() <= patch.radius_m)
+      vertices.push_back(int(v));
+  return vertices;
+}
+
+Eigen::Vector3d mean_displacement(const Eigen::MatrixX3d& displacement,
+                                  const std::vector<int>& vertices) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int v : vertices)
+    sum += displacement.row(v).transpose();
+  return vertices.empty() ? sum : Eigen::Vector3d(sum / double(vertices.size()));
 }
 
 double volume_change(const cases::Surface& surface, const Eigen::MatrixX3d& displacement) {
@@ -148,6 +187,7 @@ Problem make_problem(const cases::CaseParameters& parameters) {
       problem.tools.push_back(t);
     }
   }
+  if (parameters.loads.patch_force.enabled) check_patch_force(problem);
   if (problem.tools.empty() && !parameters.loads.patch_force.enabled &&
       !(parameters.loads.gravity_m_per_s2.norm() > 0))
     throw cases::InputError(parameters.file.string() +

@@ -1,6 +1,7 @@
 // The run's numbers as JSON and as a table: the interface users' scripts and CI read.
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -22,6 +23,19 @@ nlohmann::json optional_json(const std::optional<T>& value) {
   return value ? nlohmann::json(*value) : nlohmann::json();
 }
 
+nlohmann::json optional_vec(const std::optional<Eigen::Vector3d>& v) {
+  return v ? vec(*v) : nlohmann::json();
+}
+
+// The reference's own error at load `load` (nulls where it was not estimated or, for the force,
+// where no force is measured).
+nlohmann::json estimate_at(const CaseRun& run, std::size_t load) {
+  LoadErrorEstimate e;
+  if (load < run.fem_error.loads.size()) e = run.fem_error.loads[load];
+  return {{"estimated_rel_l2_error", optional_json(e.rel_l2_error)},
+          {"estimated_force_rel_error", optional_json(e.force_rel_error)}};
+}
+
 nlohmann::json zone(const ErrorMetrics& m) {
   return {
       {"rel_l2_error", m.rel_l2_error}, {"max_error_m", m.max_error_m}, {"vertices", m.vertices}};
@@ -36,9 +50,10 @@ nlohmann::json curve_json(const std::vector<ForceDepthPoint>& curve) {
   return points;
 }
 
-nlohmann::json load_json(int tool, const ToolLoadVariant& o) {
+nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o) {
   const ZonedErrorMetrics& e = o.errors;
   return {{"tool", tool},
+          {"not_resolved_by_reference", unresolved_metrics(run, o, tool)},
           {"rel_l2_error", e.all.rel_l2_error},
           {"rms_error_m", e.all.rms_error_m},
           {"max_error_m", e.all.max_error_m},
@@ -60,7 +75,7 @@ nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
   double l2 = 0.0, force = 0.0;
   const std::vector<ToolLoadVariant> loads = per_tool(run, v);
   for (std::size_t t = 0; t < loads.size(); ++t) {
-    list.push_back(load_json(static_cast<int>(t), loads[t]));
+    list.push_back(load_json(run, static_cast<int>(t), loads[t]));
     l2 += loads[t].errors.all.rel_l2_error;
     force += loads[t].reaction_force_rel_error;
   }
@@ -108,20 +123,31 @@ std::string machine_description() {
 nlohmann::json summary_json(const CaseRun& run) {
   const auto& p = run.problem.parameters;
   const auto& st = run.fem.statistics;
-  nlohmann::json fem = {{"degree", p.fem.degree},
-                        {"dofs", st.dofs},
-                        {"cells", st.cells},
-                        {"vertices", st.vertices},
-                        {"solve_time_s", st.solve_time_s},
-                        {"assemble_time_s", st.assemble_time_s},
-                        {"iterations", st.iterations},
-                        {"solver", run.fem.solver.empty() ? p.fem.solver : run.fem.solver},
-                        {"mpi_ranks", st.mpi_ranks},
-                        {"reaction_force_N", vec(run.fem.tool_force)},
-                        {"volume_change", run.fem.volume_change},
-                        {"worst_cell_quality", optional_json(run.worst_cell_quality)},
-                        {"cache_key", run.fem_cache_key},
-                        {"from_cache", run.fem_from_cache}};
+  nlohmann::json fem = {
+      {"degree", p.fem.degree},
+      {"dofs", st.dofs},
+      {"cells", st.cells},
+      {"vertices", st.vertices},
+      {"solve_time_s", st.solve_time_s},
+      {"assemble_time_s", st.assemble_time_s},
+      {"iterations", st.iterations},
+      {"solver", run.fem.solver.empty() ? p.fem.solver : run.fem.solver},
+      {"mpi_ranks", st.mpi_ranks},
+      {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(run.fem.tool_force)},
+      {"volume_change", run.fem.volume_change},
+      {"worst_cell_quality", optional_json(run.worst_cell_quality)},
+      {"cache_key", run.fem_cache_key},
+      {"from_cache", run.fem_from_cache},
+      {"error_estimate",
+       {{"method", run.fem_error.method},
+        {"note", run.fem_error.note},
+        {"dofs", run.fem_error.dofs},
+        {"time_s", run.fem_error.time_s}}}};
+  fem.update(estimate_at(run, 0));
+  const std::vector<int> patch = patch_vertices(run.problem);
+  fem["patch_mean_displacement_m"] =
+      patch.empty() ? nlohmann::json()
+                    : vec(mean_displacement(run.fem.surface_displacement, patch));
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& pt : run.fem_force_depth)
     curve.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
@@ -134,46 +160,53 @@ nlohmann::json summary_json(const CaseRun& run) {
                      {"reaction_force_N", vec(run.fem.tool_force)},
                      {"iterations", st.iterations},
                      {"solve_time_s", st.solve_time_s}});
-    for (const auto& load : run.other_tools)
+    loads.back().update(estimate_at(run, 0));
+    for (const auto& load : run.other_tools) {
       loads.push_back({{"tool", load.tool},
                        {"reaction_force_N", vec(load.fem.tool_force)},
                        {"iterations", load.fem.statistics.iterations},
                        {"solve_time_s", load.fem.statistics.solve_time_s}});
+      loads.back().update(estimate_at(run, static_cast<std::size_t>(load.tool)));
+    }
     fem["loads"] = loads;
   }
 
   nlohmann::json variants = nlohmann::json::array();
   for (const auto& v : run.variants) {
     const nlohmann::json fd = curve_json(v.force_depth);
-    variants.push_back({{"name", v.name},
-                        {"nodes", v.nodes},
-                        {"springs", v.springs},
-                        {"rel_l2_error", v.errors.all.rel_l2_error},
-                        {"rms_error_m", v.errors.all.rms_error_m},
-                        {"max_error_m", v.errors.all.max_error_m},
-                        {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
-                        {"contact_zone", zone(v.errors.contact_zone)},
-                        {"far_field", zone(v.errors.far_field)},
-                        {"reaction_force_N", vec(v.tool_force)},
-                        {"reaction_force_rel_error",
-                         run.problem.tools.empty() ? nlohmann::json()
-                                                   : nlohmann::json(v.reaction_force_rel_error)},
-                        {"volume_change", v.volume_change},
-                        {"integrator", v.timing.integrator},
-                        {"dt_s", v.timing.dt_s},
-                        {"steps_per_second", v.timing.steps_per_second},
-                        {"stable_dt_s", v.timing.stable_dt_s},
-                        {"predicted_stable_dt_s", v.timing.predicted_stable_dt_s},
-                        {"realtime_factor", v.timing.realtime_factor},
-                        {"settle_time_s", v.timing.settle_time_s},
-                        {"settled", v.timing.settled},
-                        {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
-                        {"newton_iterations", v.newton_iterations},
-                        {"force_depth", fd},
-                        {"force_depth_monotone", optional_json(v.force_depth_monotone)},
-                        {"inverted_elements", optional_json(v.inverted_elements)},
-                        {"warnings", v.warnings},
-                        {"parameters", v.parameters}});
+    variants.push_back(
+        {{"name", v.name},
+         {"nodes", v.nodes},
+         {"springs", v.springs},
+         {"rel_l2_error", v.errors.all.rel_l2_error},
+         {"rms_error_m", v.errors.all.rms_error_m},
+         {"max_error_m", v.errors.all.max_error_m},
+         {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
+         {"contact_zone", zone(v.errors.contact_zone)},
+         {"far_field", zone(v.errors.far_field)},
+         {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(v.tool_force)},
+         {"reaction_force_rel_error", run.problem.tools.empty()
+                                          ? nlohmann::json()
+                                          : nlohmann::json(v.reaction_force_rel_error)},
+         {"volume_change", v.volume_change},
+         {"patch_mean_displacement_m", optional_vec(v.patch_mean_displacement)},
+         {"patch_displacement_rel_error", optional_json(v.patch_displacement_rel_error)},
+         {"not_resolved_by_reference", unresolved_metrics(run, v)},
+         {"integrator", v.timing.integrator},
+         {"dt_s", v.timing.dt_s},
+         {"steps_per_second", v.timing.steps_per_second},
+         {"stable_dt_s", v.timing.stable_dt_s},
+         {"predicted_stable_dt_s", v.timing.predicted_stable_dt_s},
+         {"realtime_factor", v.timing.realtime_factor},
+         {"settle_time_s", v.timing.settle_time_s},
+         {"settled", v.timing.settled},
+         {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
+         {"newton_iterations", v.newton_iterations},
+         {"force_depth", fd},
+         {"force_depth_monotone", optional_json(v.force_depth_monotone)},
+         {"inverted_elements", optional_json(v.inverted_elements)},
+         {"warnings", v.warnings},
+         {"parameters", v.parameters}});
     if (!run.other_tools.empty()) variants.back()["loads"] = variant_loads(run, v);
   }
   nlohmann::json failed = nlohmann::json::array();
@@ -208,6 +241,62 @@ nlohmann::json summary_json(const CaseRun& run) {
           {"wall_time_s", run.wall_time_s}};
 }
 
+namespace {
+
+// "0.1234", with ‡ where the reference's own error is within 3x of it.
+std::string error_cell(double error, bool unresolved) {
+  char cell[32];
+  std::snprintf(cell, sizeof cell, "%.4f%s", error, unresolved ? " ‡" : "");
+  return cell;
+}
+
+bool contains(const std::vector<std::string>& list, const std::string& item) {
+  return std::find(list.begin(), list.end(), item) != list.end();
+}
+
+// Below the table: the reference's own error, and the patch comparison of a patch-force load.
+std::string table_notes(const CaseRun& run) {
+  std::ostringstream out;
+  const FemErrorEstimate& e = run.fem_error;
+  const LoadErrorEstimate first = e.loads.empty() ? LoadErrorEstimate{} : e.loads.front();
+  if (first.rel_l2_error) {
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "FEM reference's own error (%s; %zu DoFs, %.1f s): rel L2 %.4f, %s %s\n",
+                  e.note.c_str(), e.dofs, e.time_s, *first.rel_l2_error,
+                  run.problem.tools.empty() && !patch_vertices(run.problem).empty()
+                      ? "patch displacement"
+                      : "force",
+                  first.force_rel_error ? error_cell(*first.force_rel_error, false).c_str() : "-");
+    out << line;
+    if (std::any_of(run.variants.begin(), run.variants.end(),
+                    [&](const auto& v) { return !unresolved_metrics(run, v).empty(); }))
+      out << "‡ within 3x of the reference's own error: not resolved by this reference\n";
+  } else {
+    out << "FEM reference's own error: " << e.note << "\n";
+  }
+  const std::vector<int> patch = patch_vertices(run.problem);
+  if (!patch.empty()) {
+    const Eigen::Vector3d fem = mean_displacement(run.fem.surface_displacement, patch);
+    char line[256];
+    std::snprintf(line, sizeof line, "patch force on %zu vertices: mean displacement FEM %.3f mm",
+                  patch.size(), 1e3 * fem.norm());
+    out << line;
+    for (const auto& v : run.variants) {
+      std::snprintf(line, sizeof line, "; %s %.3f mm (err %s)", v.name.c_str(),
+                    1e3 * v.patch_mean_displacement->norm(),
+                    error_cell(*v.patch_displacement_rel_error,
+                               contains(unresolved_metrics(run, v), "patch_displacement_rel_error"))
+                        .c_str());
+      out << line;
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
 std::string variant_table(const CaseRun& run) {
   std::ostringstream out;
   char line[512];
@@ -218,28 +307,40 @@ std::string variant_table(const CaseRun& run) {
   out << line;
   out << "|--------------|--------|---------|-----------|-----------|-----------|-----------|------"
          "------|-----------|-----------|\n";
+  // Without a tool no force is measured: dashes, not a zero that reads as a perfect force.
+  const bool tool = !run.problem.tools.empty();
+  char fem_force[32] = "-";
+  if (tool) std::snprintf(fem_force, sizeof fem_force, "%.4g", run.fem.tool_force.norm());
   std::snprintf(line, sizeof line,
-                "| %-12s | %6zu | %7s | %9s | %9s | %9.4g | %9s | %10s | %9s | %9s |\n",
+                "| %-12s | %6zu | %7s | %9s | %9s | %9s | %9s | %10s | %9s | %9s |\n",
                 ("FEM P" + std::to_string(run.problem.parameters.fem.degree)).c_str(),
-                static_cast<std::size_t>(run.fem.statistics.vertices), "-", "-", "-",
-                run.fem.tool_force.norm(), "-", "-", "-", "-");
+                static_cast<std::size_t>(run.fem.statistics.vertices), "-", "-", "-", fem_force,
+                "-", "-", "-", "-");
   out << line;
   for (const auto& v : run.variants) {
     // Not timed (--no-timing): dashes, not zeros that read as measurements.
     const bool timed = !v.timing.integrator.empty();
-    char steps[32] = "-", dt[32] = "-", frame[32] = "-";
+    char steps[32] = "-", dt[32] = "-", frame[32] = "-", force[32] = "-";
     if (timed) {
       std::snprintf(steps, sizeof steps, "%.0f", v.timing.steps_per_second);
       std::snprintf(dt, sizeof dt, "%.3g", v.timing.stable_dt_s);
       std::snprintf(frame, sizeof frame, "%.3f", v.timing.ms_per_60hz_frame);
     }
-    std::snprintf(line, sizeof line,
-                  "| %-12s | %6d | %7d | %9.4f | %9.4f | %9.4g | %9.4f | %10s | %9s | %9s |\n",
-                  v.name.c_str(), v.nodes, v.springs, v.errors.all.rel_l2_error,
-                  1e3 * v.errors.all.max_error_m, v.tool_force.norm(), v.reaction_force_rel_error,
-                  steps, dt, frame);
+    const std::vector<std::string> unresolved = unresolved_metrics(run, v);
+    std::string force_error = "-";
+    if (tool) {
+      std::snprintf(force, sizeof force, "%.4g", v.tool_force.norm());
+      force_error =
+          error_cell(v.reaction_force_rel_error, contains(unresolved, "reaction_force_rel_error"));
+    }
+    std::snprintf(
+        line, sizeof line, "| %-12s | %6d | %7d | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
+        v.name.c_str(), v.nodes, v.springs,
+        error_cell(v.errors.all.rel_l2_error, contains(unresolved, "rel_l2_error")).c_str(),
+        1e3 * v.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
     out << line;
   }
+  out << table_notes(run);
   return out.str();
 }
 

@@ -75,6 +75,11 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
       pt.steps_per_second = t.steps_per_second;
       pt.realtime_factor = t.realtime_factor;
       pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
+      if (!run.fem_error.loads.empty()) {
+        pt.fem_estimated_rel_l2_error = run.fem_error.loads.front().rel_l2_error;
+        pt.fem_estimated_force_rel_error = run.fem_error.loads.front().force_rel_error;
+      }
+      pt.not_resolved_by_reference = unresolved_metrics(run, v);
       points.push_back(pt);
     }
   }
@@ -113,21 +118,31 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   return result;
 }
 
+namespace {
+nlohmann::json optional_number(const std::optional<double>& x) {
+  return x ? nlohmann::json(*x) : nlohmann::json();
+}
+}  // namespace
+
 nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& p : result.points)
-    list.push_back({{"variant", p.variant},
-                    {"integrator", p.integrator},
-                    {"resolution", p.resolution},
-                    {"surface_vertices", p.surface_vertices},
-                    {"nodes", p.nodes},
-                    {"springs", p.springs},
-                    {"rel_l2_error", p.rel_l2_error},
-                    {"reaction_force_rel_error", p.reaction_force_rel_error},
-                    {"stable_dt_s", p.stable_dt_s},
-                    {"steps_per_second", p.steps_per_second},
-                    {"realtime_factor", p.realtime_factor},
-                    {"ms_per_60hz_frame", p.ms_per_60hz_frame}});
+    list.push_back(
+        {{"variant", p.variant},
+         {"integrator", p.integrator},
+         {"resolution", p.resolution},
+         {"surface_vertices", p.surface_vertices},
+         {"nodes", p.nodes},
+         {"springs", p.springs},
+         {"rel_l2_error", p.rel_l2_error},
+         {"reaction_force_rel_error", p.reaction_force_rel_error},
+         {"stable_dt_s", p.stable_dt_s},
+         {"steps_per_second", p.steps_per_second},
+         {"realtime_factor", p.realtime_factor},
+         {"ms_per_60hz_frame", p.ms_per_60hz_frame},
+         {"fem_estimated_rel_l2_error", optional_number(p.fem_estimated_rel_l2_error)},
+         {"fem_estimated_force_rel_error", optional_number(p.fem_estimated_force_rel_error)},
+         {"not_resolved_by_reference", p.not_resolved_by_reference}});
   nlohmann::json failed = nlohmann::json::array();
   for (const auto& [resolution, why] : result.failed_resolutions)
     failed.push_back({{"resolution", resolution}, {"error", why}});
@@ -142,17 +157,34 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
 std::string sweep_table(const std::vector<SweepPoint>& points) {
   std::ostringstream out;
   out << "| variant | integrator | resolution | surface vertices | nodes | springs | rel L2 | "
-         "force err | stable dt s | steps/s | realtime factor | ms/60 Hz frame |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "force err | FEM own err (L2 / force) | stable dt s | steps/s | realtime factor | "
+         "ms/60 Hz frame |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char row[512];
+  auto number = [](const std::optional<double>& x) {
+    char cell[32] = "-";
+    if (x) std::snprintf(cell, sizeof cell, "%.4f", *x);
+    return std::string(cell);
+  };
+  auto flag = [](const SweepPoint& p, const char* metric) {
+    const auto& list = p.not_resolved_by_reference;
+    return std::find(list.begin(), list.end(), metric) != list.end() ? " ‡" : "";
+  };
+  bool any_flag = false;
   for (const auto& p : points) {
-    std::snprintf(row, sizeof row,
-                  "| %s | %s | %d | %d | %d | %d | %.4f | %.4f | %.3g | %.0f | %.3g | %.3f |\n",
-                  p.variant.c_str(), p.integrator.c_str(), p.resolution, p.surface_vertices,
-                  p.nodes, p.springs, p.rel_l2_error, p.reaction_force_rel_error, p.stable_dt_s,
-                  p.steps_per_second, p.realtime_factor, p.ms_per_60hz_frame);
+    std::snprintf(
+        row, sizeof row,
+        "| %s | %s | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | %.3g | %.3f |\n",
+        p.variant.c_str(), p.integrator.c_str(), p.resolution, p.surface_vertices, p.nodes,
+        p.springs, p.rel_l2_error, flag(p, "rel_l2_error"), p.reaction_force_rel_error,
+        flag(p, "reaction_force_rel_error"), number(p.fem_estimated_rel_l2_error).c_str(),
+        number(p.fem_estimated_force_rel_error).c_str(), p.stable_dt_s, p.steps_per_second,
+        p.realtime_factor, p.ms_per_60hz_frame);
     out << row;
+    any_flag = any_flag || !p.not_resolved_by_reference.empty();
   }
+  if (any_flag)
+    out << "\n‡ within 3x of the reference's own error: not resolved by this reference\n";
   return out.str();
 }
 

@@ -98,15 +98,11 @@ void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
   const auto& patch = problem.parameters.loads.patch_force;
   if (!patch.enabled) return;
   const auto& s = problem.surface;
-  const int center = farthest_vertex(s, problem.centroid, patch.direction);
   const Eigen::VectorXd areas = ms::vertex_areas(s.vertices, s.triangles);
-  std::vector<int> nodes;
+  const std::vector<int> nodes = patch_vertices(problem);
   double total_area = 0;
-  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
-    if ((s.vertices.row(v) - s.vertices.row(center)).norm() <= patch.radius_m) {
-      nodes.push_back(static_cast<int>(v));
-      total_area += areas[v];
-    }
+  for (int v : nodes)
+    total_area += areas[v];
   const auto& surface_nodes = model.network().surface_nodes;
   for (int v : nodes)
     model.set_external_force(surface_nodes[v], patch.force_n * areas[v] / total_area);

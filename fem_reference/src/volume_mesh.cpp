@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace msfem::fem_reference {
@@ -69,6 +71,59 @@ void check_volume_mesh(const VolumeMesh& mesh) {
     if (!(signed_tetrahedron_volume(mesh, e) > 0.0))
       throw std::invalid_argument("tetrahedron " + std::to_string(e) + " has non-positive volume");
   }
+}
+
+VolumeMesh refine_uniformly(const VolumeMesh& mesh) {
+  VolumeMesh fine;
+  fine.num_surface_vertices = mesh.num_surface_vertices;
+  const Eigen::Index n = mesh.num_vertices();
+  std::unordered_map<std::int64_t, int> midpoint_of;
+  std::vector<Eigen::Vector3d> midpoints;
+  auto midpoint = [&](int a, int b) {
+    const std::int64_t key = std::int64_t(std::min(a, b)) * n + std::max(a, b);
+    const auto [it, added] = midpoint_of.try_emplace(key, int(n + Eigen::Index(midpoints.size())));
+    if (added) midpoints.push_back(0.5 * (mesh.vertices.row(a) + mesh.vertices.row(b)).transpose());
+    return it->second;
+  };
+  std::vector<std::array<int, 4>> children;
+  children.reserve(std::size_t(8 * mesh.num_tetrahedra()));
+  for (Eigen::Index e = 0; e < mesh.num_tetrahedra(); ++e) {
+    const auto t = mesh.tetrahedra.row(e);
+    const int m01 = midpoint(t(0), t(1)), m02 = midpoint(t(0), t(2)), m03 = midpoint(t(0), t(3)),
+              m12 = midpoint(t(1), t(2)), m13 = midpoint(t(1), t(3)), m23 = midpoint(t(2), t(3));
+    children.push_back({t(0), m01, m02, m03});
+    children.push_back({m01, t(1), m12, m13});
+    children.push_back({m02, m12, t(2), m23});
+    children.push_back({m03, m13, m23, t(3)});
+    // The octahedron's three diagonals, each with the cycle of the four other midpoints around it.
+    const std::array<std::array<int, 6>, 3> cuts = {{{m01, m23, m02, m03, m13, m12},
+                                                     {m02, m13, m01, m03, m23, m12},
+                                                     {m03, m12, m01, m02, m23, m13}}};
+    auto at = [&](int a, int b) -> Eigen::Vector3d {
+      return 0.5 * (mesh.vertices.row(t(a)) + mesh.vertices.row(t(b))).transpose();
+    };
+    const std::array<double, 3> diagonal = {(at(0, 1) - at(2, 3)).squaredNorm(),
+                                            (at(0, 2) - at(1, 3)).squaredNorm(),
+                                            (at(0, 3) - at(1, 2)).squaredNorm()};
+    const auto& cut =
+        cuts[std::size_t(std::min_element(diagonal.begin(), diagonal.end()) - diagonal.begin())];
+    for (int k = 0; k < 4; ++k)
+      children.push_back(
+          {cut[0], cut[1], cut[std::size_t(2 + k)], cut[std::size_t(2 + (k + 1) % 4)]});
+  }
+  fine.vertices.resize(n + Eigen::Index(midpoints.size()), 3);
+  fine.vertices.topRows(n) = mesh.vertices;
+  for (std::size_t i = 0; i < midpoints.size(); ++i)
+    fine.vertices.row(n + Eigen::Index(i)) = midpoints[i].transpose();
+  fine.tetrahedra.resize(Eigen::Index(children.size()), 4);
+  for (std::size_t c = 0; c < children.size(); ++c) {
+    for (int k = 0; k < 4; ++k)
+      fine.tetrahedra(Eigen::Index(c), k) = children[c][std::size_t(k)];
+    // The parents are positively oriented; the octahedron's children may come out mirrored.
+    if (signed_tetrahedron_volume(fine, Eigen::Index(c)) < 0.0)
+      std::swap(fine.tetrahedra(Eigen::Index(c), 2), fine.tetrahedra(Eigen::Index(c), 3));
+  }
+  return fine;
 }
 
 std::vector<unsigned int> partition_cells(const VolumeMesh& mesh, unsigned int parts) {

@@ -28,14 +28,24 @@ std::string to_string(IntegratorKind kind) {
   return "unknown";
 }
 
+const std::vector<IntegratorKind>& all_integrators() {
+  static const std::vector<IntegratorKind> kinds = {
+      IntegratorKind::explicit_euler, IntegratorKind::symplectic_euler,
+      IntegratorKind::central_difference, IntegratorKind::rk4, IntegratorKind::implicit_euler};
+  return kinds;
+}
+
+std::string integrator_names(const std::string& separator) {
+  std::string names;
+  for (IntegratorKind kind : all_integrators())
+    names += (names.empty() ? "" : separator) + to_string(kind);
+  return names;
+}
+
 IntegratorKind parse_integrator(const std::string& name) {
-  for (IntegratorKind kind :
-       {IntegratorKind::explicit_euler, IntegratorKind::symplectic_euler,
-        IntegratorKind::central_difference, IntegratorKind::rk4, IntegratorKind::implicit_euler})
+  for (IntegratorKind kind : all_integrators())
     if (to_string(kind) == name) return kind;
-  throw ModelError("integrator '" + name +
-                   "': unknown (explicit_euler, symplectic_euler, "
-                   "central_difference, rk4, implicit_euler)");
+  throw ModelError("integrator '" + name + "': unknown (" + integrator_names(", ") + ")");
 }
 
 void check_time_step(double dt) {

@@ -6,6 +6,7 @@
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/massspring/integrators.hpp"
 
 namespace msfem::cases {
 namespace {
@@ -146,6 +147,38 @@ TEST(CaseLanguage, DescribesEverySection) {
                         "mass spring", "three tier", "skeleton", "fem", "timing", "output"})
     EXPECT_NE(text.find("subsection " + std::string(s)), std::string::npos) << s;
   EXPECT_NE(text.find("youngs modulus"), std::string::npos);
+}
+
+// The case language takes exactly the integrators massspring steps: every one is read back as
+// given (central_difference, the skeleton paper's scheme, included) and a name massspring does not
+// know is refused when the file is read, naming the file and line.
+TEST_F(CaseFile, EveryIntegratorMassspringKnowsAndNoOther) {
+  const auto p = write("c.prm", "subsection timing\n  set integrator = symplectic_euler\nend\n");
+  for (massspring::IntegratorKind kind : massspring::all_integrators()) {
+    const std::string name = massspring::to_string(kind);
+    EXPECT_EQ(read_case(p, {"timing/integrator=" + name}).timing.integrator, name);
+  }
+  EXPECT_EQ(massspring::to_string(massspring::parse_integrator("central_difference")),
+            "central_difference");
+  const auto bad = write("bad.prm", "subsection timing\n  set integrator = verlet\nend\n");
+  const std::string error = error_of(bad);
+  EXPECT_NE(error.find("bad.prm"), std::string::npos) << error;
+  EXPECT_NE(error.find("line"), std::string::npos) << error;
+  EXPECT_NE(error.find("verlet"), std::string::npos) << error;
+}
+
+TEST_F(CaseFile, ErrorEstimateMethodsAndTheirLimits) {
+  const auto p = write("c.prm", "subsection fem\n  set degree = 1\nend\n");
+  EXPECT_EQ(read_case(p).fem.error_estimate, FemParameters::ErrorEstimate::automatic);
+  for (const char* name : {"auto", "refine", "degree", "none"}) {
+    const FemParameters fem = read_case(p, {std::string("fem/error estimate=") + name}).fem;
+    EXPECT_STREQ(error_estimate_name(fem.error_estimate), name);
+  }
+  // P3 does not exist on tetrahedra: degree + 1 of a P2 reference is refused at once.
+  const std::string error = error_of(p, {"fem/degree=2", "fem/error estimate=degree"});
+  EXPECT_NE(error.find("c.prm"), std::string::npos) << error;
+  EXPECT_NE(error.find("fem/error estimate"), std::string::npos) << error;
+  EXPECT_NE(error_of(p, {"fem/error estimate=coarsen"}), "");
 }
 
 }  // namespace

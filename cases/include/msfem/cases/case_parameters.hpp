@@ -74,8 +74,10 @@ struct LoadParameters {
 };
 
 /// Knobs of the mass-spring variants. Stiffness starts from the analytic value (Lloyd et al. 2007
-/// or van Gelder 1998) times a per-group factor; damping is a damping ratio of the slowest... see
-/// docs.
+/// or van Gelder 1998) times a per-group factor; each spring gets the axial damper
+/// d = 2 r sqrt(k m_a m_b / (m_a + m_b)), r = `damping_ratio`, which damps the two-body oscillator
+/// of that spring and its end masses at r of critical (`msfem calibrate` chooses r for a target
+/// modal damping ratio, docs/calibration.md).
 struct MassSpringParameters {
   std::vector<std::string> variants = {"three_tier", "single_layer", "tet_edges", "skeleton"};
   std::string stiffness_model = "lloyd";  ///< lloyd | van_gelder
@@ -99,7 +101,15 @@ struct FemParameters {
   /// contact patch however coarse the case's surface is.
   bool refine_at_tool = true;
   double tool_cell_size_m = 0.0;  ///< edge length there; 0: the tool radius / 3
+  /// How the reference's own discretisation error is estimated (docs/harness.md).
+  enum class ErrorEstimate { automatic, refine, degree, none };
+  ErrorEstimate error_estimate = ErrorEstimate::automatic;
 };
+
+/// The case-file names of FemParameters::ErrorEstimate ("auto", "refine", "degree", "none").
+const char* error_estimate_name(FemParameters::ErrorEstimate method);
+/// Throws InputError for a name not in error_estimate_name's list.
+FemParameters::ErrorEstimate error_estimate_from_name(const std::string& name);
 
 struct TimingParameters {
   std::string integrator = "symplectic_euler";

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "msfem/compare/fem_error_estimate.hpp"
 #include "msfem/compare/fem_run.hpp"
 #include "msfem/compare/metrics.hpp"
 #include "msfem/compare/problem.hpp"
@@ -48,6 +49,10 @@ struct ToolLoadVariant {
   std::optional<int> inverted_elements;
   std::vector<ForceDepthPoint> force_depth;  ///< every step of its loading path
   std::optional<bool> force_depth_monotone;  ///< along its loading path
+  /// With a patch force: the patch's mean displacement (what a force-controlled load measures)
+  /// and its error against the FEM's, |ū − ū_FEM| / |ū_FEM|.
+  std::optional<Eigen::Vector3d> patch_mean_displacement;
+  std::optional<double> patch_displacement_rel_error;
 };
 
 /// The variant at the run's own (first) tool position, with what only that load gets.
@@ -85,6 +90,7 @@ struct CaseRun {
   std::vector<std::pair<std::string, std::string>> failed_variants;
   std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
   std::vector<ToolLoad> other_tools;   ///< the case's second and later tool positions
+  FemErrorEstimate fem_error;          ///< the reference's own error, per load
   double wall_time_s = 0.0;
   std::string fem_cache_key;
   bool fem_from_cache = false;
@@ -114,6 +120,11 @@ std::vector<double> loading_path(std::vector<double> depths, double case_depth, 
 /// The variant at every tool position of the run, in tool order: tool 0 from its own result, then
 /// the other tools' (what summary.json's `loads` and report.md's per-tool table show).
 std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& variant);
+
+/// The metrics (summary.json names) of `variant` at load `load` that lie within 3x the reference's
+/// own estimated error there: the reference does not resolve the variant's error in them.
+std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
+                                            int load = 0);
 
 /// Whether the force the tissue exerts on the tool, along the tool's outward normal, grows strictly
 /// from each depth of the curve to the next deeper one; none without a tool or with fewer than

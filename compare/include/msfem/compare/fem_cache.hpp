@@ -20,6 +20,7 @@ struct FemCacheEntry {
   std::vector<ForceDepthPoint> force_depth;
   /// The problem's second and later tools at full depth (surface displacement, force, statistics).
   std::vector<FemSolution> other_tools;
+  FemErrorEstimate error_estimate;  ///< the reference's own error (fem/error estimate)
 };
 
 /// 16 hex digits of a 64-bit FNV-1a hash of the problem's FEM inputs and the curve depths, and

@@ -46,6 +46,14 @@ Problem make_problem(const cases::CaseParameters& parameters);
 int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
                     const Eigen::Vector3d& direction);
 
+/// The surface vertices a patch force pulls (empty without one): within its radius of the vertex
+/// farthest along its direction.
+std::vector<int> patch_vertices(const Problem& problem);
+
+/// Mean displacement of `displacement`'s rows `vertices`.
+Eigen::Vector3d mean_displacement(const Eigen::MatrixX3d& displacement,
+                                  const std::vector<int>& vertices);
+
 /// Enclosed volume of the surface moved by `displacement` (per vertex) over its rest volume, − 1.
 double volume_change(const cases::Surface& surface, const Eigen::MatrixX3d& displacement);
 

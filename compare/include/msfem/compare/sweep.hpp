@@ -2,6 +2,7 @@
 // `msfem sweep`: accuracy against speed over variants × resolutions × integrators.
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,6 +28,10 @@ struct SweepPoint {
   double rel_l2_error = 0.0, reaction_force_rel_error = 0.0;
   double stable_dt_s = 0.0, steps_per_second = 0.0, realtime_factor = 0.0;
   double ms_per_60hz_frame = 0.0;
+  /// The resolution's FEM reference's own error (fem/error estimate; none where not estimated)
+  /// and the variant's metrics within 3x of it.
+  std::optional<double> fem_estimated_rel_l2_error, fem_estimated_force_rel_error;
+  std::vector<std::string> not_resolved_by_reference;
 };
 
 struct SweepResult {

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "msfem/massspring/mass_spring_model.hpp"
 
@@ -29,6 +30,11 @@ enum class IntegratorKind {
 
 /// "explicit_euler", "symplectic_euler", "central_difference", "rk4", "implicit_euler".
 std::string to_string(IntegratorKind kind);
+/// Every integrator, in declaration order: the one list case files, `msfem sweep --integrators`
+/// and parse_integrator accept.
+const std::vector<IntegratorKind>& all_integrators();
+/// Their names joined by `separator` ("|" gives a deal.II Selection pattern).
+std::string integrator_names(const std::string& separator);
 /// Inverse of to_string; throws ModelError naming the value.
 IntegratorKind parse_integrator(const std::string& name);
 
