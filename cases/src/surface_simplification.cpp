@@ -32,8 +32,7 @@ Surface simplify(const Surface& surface, int target_vertices) {
   SMS::Count_stop_predicate<detail::CgalMesh> stop(target_edges + 1);
   // The filter refuses collapses that would turn a triangle over, the usual cause of folds (and
   // so self-intersections) in tightly curved surfaces such as the cortex.
-  SMS::edge_collapse(mesh, stop,
-                     CGAL::parameters::filter(SMS::Bounded_normal_change_filter<>()));
+  SMS::edge_collapse(mesh, stop, CGAL::parameters::filter(SMS::Bounded_normal_change_filter<>()));
   mesh.collect_garbage();
 
   Surface result = detail::from_cgal(mesh);

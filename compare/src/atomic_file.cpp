@@ -123,11 +123,16 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
 
 void fill_directory_atomically(const fs::path& directory,
                                const std::function<void(const fs::path& work)>& fill) {
+  if (directory.empty()) throw cases::InputError("the output folder is an empty path");
   if (fs::exists(directory) && !(fs::is_directory(directory) && fs::is_empty(directory)))
     throw cases::InputError(directory.string() + ": output folder exists and is not empty");
   const fs::path work = temporary_name_for(directory);
   const PendingTemporary pending(work);
-  fs::create_directories(work);
+  std::error_code created;
+  fs::create_directories(work, created);
+  if (created)
+    throw cases::InputError(directory.string() + ": cannot create the output folder there (" +
+                            created.message() + ")");
   try {
     fill(work);
     std::error_code ignored;
@@ -139,6 +144,18 @@ void fill_directory_atomically(const fs::path& directory,
     fs::remove_all(work, ignored);
     throw;  // as it was: bad input stays bad input
   }
+}
+
+fs::path fem_cache_beside(const fs::path& run_folder) {
+  const fs::path parent = run_folder.has_parent_path() ? run_folder.parent_path() : fs::path(".");
+  const fs::path cache = parent / ".fem-cache";
+  std::error_code failed;
+  fs::create_directories(cache, failed);
+  if (failed || access(cache.c_str(), W_OK) != 0)
+    throw cases::InputError(cache.string() + ": cannot write the FEM cache there (" +
+                            (failed ? failed.message() : std::string("not writable")) +
+                            "); give --no-cache or an --out in a writable folder");
+  return cache;
 }
 
 }  // namespace msfem::compare

@@ -58,6 +58,21 @@ void check_loads(const cases::CaseParameters& p, const std::vector<cases::ToolLo
   check_unique(test, "held-out");
 }
 
+// Before any solve: every group to fit is one the variant has.
+void check_fit_groups(const cases::CaseParameters& p, const std::string& variant,
+                      const std::vector<std::string>& groups) {
+  std::vector<std::string> known = spring_groups_of(variant);
+  if (p.mass_spring.volume_preservation) known.emplace_back(volume_group);
+  for (const auto& g : groups)
+    if (std::find(known.begin(), known.end(), g) == known.end()) {
+      std::string list;
+      for (const auto& k : known)
+        list += (list.empty() ? "" : ", ") + k;
+      throw cases::InputError(p.file.string() + ": calibration: variant " + variant +
+                              " has no group '" + g + "' (its groups: " + list + ")");
+    }
+}
+
 // The case with its tool enabled at every direction the loads use, as deep as the deepest load
 // (make_problem checks that depth against the model's size).
 Problem calibration_problem(cases::CaseParameters p, const std::vector<cases::ToolLoad>& loads) {
@@ -88,6 +103,54 @@ std::string load_key(const std::string& problem_key, const cases::ToolLoad& load
   return h.hex();
 }
 
+// The reference's own error at the freshly solved loads (as many as fem/error estimate's plan
+// allows), then each fresh load stored in the cache with its estimate.
+void estimate_and_store(CaseCalibration& c, std::vector<LoadReference>& references,
+                        const std::vector<std::optional<FemCacheEntry>>& cached,
+                        const std::vector<FemSolution>& solved, const ErrorEstimatePlan& plan,
+                        const std::string& problem_key, const CalibrationRequest& request,
+                        const Progress& progress) {
+  std::vector<std::size_t> fresh;
+  std::vector<const FemSolution*> solutions;
+  std::vector<std::vector<int>> compared;
+  std::vector<std::optional<ToolPlacement>> tools;
+  for (std::size_t i = 0; i < references.size(); ++i)
+    if (!cached[i]) {
+      fresh.push_back(i);
+      solutions.push_back(&solved[solutions.size()]);
+      compared.push_back(references[i].compared_vertices);
+      tools.emplace_back(references[i].tool);
+    }
+  if (plan.method != "none" && !fresh.empty())
+    progress.stage("estimating the reference's own error (" + plan.note + ")");
+  const FemErrorEstimate estimate =
+      estimate_fem_error(c.problem, c.mesh, plan, solutions, compared, tools);
+  for (std::size_t k = 0; k < fresh.size(); ++k) {
+    LoadReference& r = references[fresh[k]];
+    r.fem_error = estimate.loads[k];
+    if (!request.fem_cache_directory) continue;
+    FemErrorEstimate one = estimate;
+    one.loads = {estimate.loads[k]};
+    store_fem_cache(*request.fem_cache_directory, load_key(problem_key, r.load),
+                    {c.mesh, solved[k], {}, {}, one});
+  }
+}
+
+// Two directions can pick the same surface vertex: a held-out load pressed where and as deep as a
+// training load is the same load, and would check the fit on what it was fitted to.
+void check_distinct_vertices(const Problem& problem, const std::vector<cases::ToolLoad>& train,
+                             const std::vector<cases::ToolLoad>& test) {
+  for (const auto& a : test)
+    for (const auto& b : train) {
+      const ToolPlacement pa = placement_of(problem, a), pb = placement_of(problem, b);
+      if (pa.vertex == pb.vertex && std::abs(a.depth_m - b.depth_m) < 1e-12)
+        throw cases::InputError(problem.parameters.file.string() + ": calibration: held-out load " +
+                                a.label() + " presses the same surface vertex (" +
+                                std::to_string(pa.vertex) + ") as deep as training load " +
+                                b.label() + ": it is the same load");
+    }
+}
+
 // The FEM of every load, from the cache where it is there.
 void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& train,
                       const std::vector<cases::ToolLoad>& test, const CalibrationRequest& request,
@@ -111,32 +174,60 @@ void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& tr
                    std::to_string(problem.tools.size()) + " tool positions");
     c.mesh = mesh_problem(problem, problem.tools);
   }
+  check_no_rigid_motion(problem, c.mesh, placement_of(problem, all.front()));
+  const int fresh = static_cast<int>(std::count(cached.begin(), cached.end(), std::nullopt));
+  // Decided (and refused, for a method that cannot run) before the first solve.
+  const ErrorEstimatePlan plan = plan_error_estimate(problem, c.mesh, fresh, fresh);
   const auto start = Clock::now();
+  std::vector<FemSolution> solved;  // the fresh loads', in load order, for the estimate
+  std::vector<LoadReference> references;
   for (std::size_t i = 0; i < all.size(); ++i) {
     LoadReference r;
     r.load = all[i];
     r.tool = placement_of(problem, all[i]);
+    const std::vector<bool> prescribed = prescribed_surface_vertices(problem, r.tool);
+    for (std::size_t v = 0; v < prescribed.size(); ++v)
+      if (!prescribed[v]) r.compared_vertices.push_back(static_cast<int>(v));
     if (cached[i]) {
       ++c.fem_from_cache;
       r.surface_displacement = cached[i]->solution.surface_displacement;
       r.tool_force = cached[i]->solution.tool_force;
+      if (!cached[i]->error_estimate.loads.empty())
+        r.fem_error = cached[i]->error_estimate.loads.front();
     } else {
-      const FemSolution s = solve_fem(problem, c.mesh, r.tool);
+      solved.push_back(solve_fem(problem, c.mesh, r.tool));
       ++c.fem_solves;
-      r.surface_displacement = s.surface_displacement;
-      r.tool_force = s.tool_force;
-      if (request.fem_cache_directory)
-        store_fem_cache(*request.fem_cache_directory, load_key(problem_key, all[i]),
-                        {c.mesh, s, {}, {}, {}});
+      r.surface_displacement = solved.back().surface_displacement;
+      r.tool_force = solved.back().tool_force;
     }
-    const std::vector<bool> prescribed = prescribed_surface_vertices(problem, r.tool);
-    for (std::size_t v = 0; v < prescribed.size(); ++v)
-      if (!prescribed[v]) r.compared_vertices.push_back(static_cast<int>(v));
-    (i < train.size() ? c.train : c.test).push_back(std::move(r));
+    references.push_back(std::move(r));
     progress.advance("FEM reference per load (" + std::to_string(c.fem_from_cache) + " cached)",
                      static_cast<int>(i + 1), static_cast<int>(all.size()), seconds_since(start));
   }
+  estimate_and_store(c, references, cached, solved, plan, problem_key, request, progress);
+  for (std::size_t i = 0; i < references.size(); ++i)
+    (i < train.size() ? c.train : c.test).push_back(std::move(references[i]));
   c.fem_time_s = seconds_since(start);
+}
+
+// Fitted errors within 3x of the reference's own at their load: the fit cannot be judged there.
+void note_unresolved_loads(CaseCalibration& c) {
+  std::string list;
+  auto check = [&](const std::vector<LoadReference>& references,
+                   const std::vector<LoadErrors>& errors) {
+    for (std::size_t i = 0; i < references.size() && i < errors.size(); ++i) {
+      const LoadErrorEstimate& e = references[i].fem_error;
+      if (within_reference_error(errors[i].rel_l2_error, e.rel_l2_error) ||
+          within_reference_error(errors[i].reaction_force_rel_error, e.force_rel_error))
+        list += (list.empty() ? "" : ", ") + references[i].load.label();
+    }
+  };
+  check(c.train, c.fit.after.train);
+  check(c.test, c.fit.after.test);
+  if (!list.empty())
+    c.notes.push_back("not resolved by this reference: after the fit, the error at " + list +
+                      " is within 3x of the FEM's own estimated error (fem.error_estimate); a "
+                      "finer fem/cell size is needed to judge the fit there");
 }
 
 // Group scales of the calibrated case: the case's own entries with the fitted groups replaced.
@@ -198,7 +289,9 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   const std::vector<cases::ToolLoad> train = request.train.value_or(defaults.train);
   const std::vector<cases::ToolLoad> test = request.test.value_or(defaults.test);
   check_loads(parameters, train, test);
+  check_variant_names(parameters);
   c.options.groups = request.groups.value_or(defaults.groups);
+  check_fit_groups(parameters, c.variant, c.options.groups);
   c.options.force_weight = defaults.force_weight;
   c.options.max_evaluations = defaults.max_evaluations;
   c.options.tolerance = defaults.tolerance;
@@ -210,6 +303,8 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   std::vector<cases::ToolLoad> all = train;
   all.insert(all.end(), test.begin(), test.end());
   c.problem = calibration_problem(parameters, all);
+  check_distinct_vertices(c.problem, train, test);
+  check_variants_fit(c.problem);
   solve_references(c, train, test, request, progress);
 
   progress.stage("fitting " + c.variant + " (BOBYQA, at most " +
@@ -299,6 +394,7 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   std::sort(c.variants.begin(), c.variants.end(),
             [](const auto& a, const auto& b) { return a.mean_rel_l2_error < b.mean_rel_l2_error; });
   if (c.test.empty()) c.notes.push_back("no held-out loads: the fit is not checked on new loads");
+  note_unresolved_loads(c);
   c.total_time_s = seconds_since(start);
   return c;
 }

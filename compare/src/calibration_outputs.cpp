@@ -24,6 +24,25 @@ nlohmann::json errors_json(const std::vector<LoadErrors>& errors) {
   return list;
 }
 
+nlohmann::json optional_number(const std::optional<double>& x) {
+  return x ? nlohmann::json(*x) : nlohmann::json();
+}
+
+// The reference's own error at every load (null where fem/error estimate left it out).
+nlohmann::json estimates_json(const CaseCalibration& c) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [side, references] :
+       {std::pair{"train", &c.train}, std::pair{"test", &c.test}}) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const LoadReference& r : *references)
+      list.push_back({{"load", r.load.label()},
+                      {"estimated_rel_l2_error", optional_number(r.fem_error.rel_l2_error)},
+                      {"estimated_force_rel_error", optional_number(r.fem_error.force_rel_error)}});
+    out[side] = list;
+  }
+  return out;
+}
+
 nlohmann::json side_json(const ErrorsOnLoads& e, double objective) {
   return {{"train", errors_json(e.train)}, {"test", errors_json(e.test)}, {"objective", objective}};
 }
@@ -201,7 +220,8 @@ nlohmann::json calibration_json(const CaseCalibration& c) {
            {{"tetrahedra", c.mesh.num_tetrahedra()},
             {"solves", c.fem_solves},
             {"from_cache", c.fem_from_cache},
-            {"time_s", c.fem_time_s}}},
+            {"time_s", c.fem_time_s},
+            {"error_estimate", estimates_json(c)}}},
           {"notes", c.notes},
           {"wall_time_s", c.total_time_s}};
 }

@@ -259,6 +259,7 @@ void reference_solutions(CaseRun& run, const RunSettings& settings,
     // Decided (and refused, for a method that cannot run) before the first solve.
     const ErrorEstimatePlan plan =
         plan_error_estimate(problem, run.mesh, reference_solve_count(problem), 1 + other_tools);
+    check_no_rigid_motion(problem, run.mesh, tool);
     progress.stage("solving the FEM reference (P" + std::to_string(problem.parameters.fem.degree) +
                    ", " + std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
     run.fem = solve_fem(problem, run.mesh, tool);
@@ -285,6 +286,45 @@ void reference_solutions(CaseRun& run, const RunSettings& settings,
     load.compared_vertices = unprescribed_vertices(problem, problem.tools[t]);
     run.other_tools.push_back(std::move(load));
   }
+}
+
+// One variant on the run's problem: pressed along the loading path at every tool, compared with
+// the FEM, timed, with its warnings.
+VariantResult run_variant(CaseRun& run, BuiltVariant& built, const std::vector<double>& path,
+                          const RunSettings& settings) {
+  const Problem& problem = run.problem;
+  const std::optional<ToolPlacement> tool =
+      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
+  VariantResult r;
+  r.nodes = built.model->num_nodes();
+  r.springs = built.model->network().num_springs();
+  r.warnings = built.warnings;
+  r.parameters = variant_parameters(*built.model);
+  std::vector<ForceDepthPoint> curve;
+  const StaticSolution s = press(built, tool, path, curve);
+  static_cast<ToolLoadVariant&>(r) =
+      compare_at_tool(problem, built, s, std::move(curve), run.fem, run.compared_vertices, tool);
+  if (r.force_depth_monotone == false)
+    r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
+  std::string unresolved;
+  for (const std::string& metric : unresolved_metrics(run, r))
+    unresolved += (unresolved.empty() ? "" : ", ") + metric;
+  if (!unresolved.empty())
+    r.warnings.push_back("not resolved by this reference: " + unresolved +
+                         " within 3x of the FEM's own estimated error (a finer fem/cell "
+                         "size resolves it)");
+  r.newton_iterations = s.newton_iterations;
+  r.equilibrium = s.x;
+  r.surface_displacement = s.surface_displacement;
+  r.error = s.surface_displacement - run.fem.surface_displacement;
+  if (settings.time_dynamics) r.timing = time_variant(built, problem.parameters.timing, s.x);
+  press_other_tools(run, built, path);
+  for (const ToolLoad& load : run.other_tools)
+    if (load.variants.back().force_depth_monotone == false)
+      r.warnings.push_back(
+          "tool " + std::to_string(load.tool) + ": " +
+          force_falls_warning(load.variants.back().force_depth, built.tetrahedra.rows()));
+  return r;
 }
 
 }  // namespace
@@ -338,16 +378,12 @@ std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,
 CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& settings) {
   const auto start = Clock::now();
   const Progress progress(settings.quiet);
-  for (const auto& v : parameters.mass_spring.variants) {
-    const auto& known = known_variants();
-    if (std::find(known.begin(), known.end(), v) == known.end())
-      throw cases::InputError(parameters.file.string() +
-                              ": mass spring/variants: unknown variant '" + v + "'");
-  }
+  check_variant_names(parameters);
   CaseRun run;
   progress.stage("loading the surface and placing supports and loads");
   run.problem = make_problem(parameters);
   const Problem& problem = run.problem;
+  check_variants_fit(problem);
   const std::optional<ToolPlacement> tool =
       problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
 
@@ -361,44 +397,19 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 
   run.compared_vertices = unprescribed_vertices(problem, tool);
 
+  // One loading path whatever a command writes: --no-curve skips the FEM's curve and the curves'
+  // output, never the path the variants are pressed along (their equilibria would differ).
+  const std::vector<double> path =
+      tool ? loading_path(curve_depths(parameters.loads.tool), tool->depth,
+                          parameters.loads.tool.path_step_m)
+           : std::vector<double>{};
   const auto variants_start = Clock::now();
   const int total = static_cast<int>(parameters.mass_spring.variants.size());
   for (int i = 0; i < total; ++i) {
     const std::string& name = parameters.mass_spring.variants[i];
     BuiltVariant built = build_variant(name, problem, run.mesh, tool);
     try {
-      VariantResult r;
-      r.nodes = built.model->num_nodes();
-      r.springs = built.model->network().num_springs();
-      r.warnings = built.warnings;
-      r.parameters = variant_parameters(*built.model);
-      const std::vector<double> path =
-          depths.empty() ? std::vector<double>{}
-                         : loading_path(depths, tool->depth, parameters.loads.tool.path_step_m);
-      std::vector<ForceDepthPoint> curve;
-      const StaticSolution s = press(built, tool, path, curve);
-      static_cast<ToolLoadVariant&>(r) = compare_at_tool(problem, built, s, std::move(curve),
-                                                         run.fem, run.compared_vertices, tool);
-      if (r.force_depth_monotone == false)
-        r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
-      std::string unresolved;
-      for (const std::string& metric : unresolved_metrics(run, r))
-        unresolved += (unresolved.empty() ? "" : ", ") + metric;
-      if (!unresolved.empty())
-        r.warnings.push_back("not resolved by this reference: " + unresolved +
-                             " within 3x of the FEM's own estimated error (a finer fem/cell "
-                             "size resolves it)");
-      r.newton_iterations = s.newton_iterations;
-      r.equilibrium = s.x;
-      r.surface_displacement = s.surface_displacement;
-      r.error = s.surface_displacement - run.fem.surface_displacement;
-      if (settings.time_dynamics) r.timing = time_variant(built, parameters.timing, s.x);
-      press_other_tools(run, built, path);
-      for (const ToolLoad& load : run.other_tools)
-        if (load.variants.back().force_depth_monotone == false)
-          r.warnings.push_back(
-              "tool " + std::to_string(load.tool) + ": " +
-              force_falls_warning(load.variants.back().force_depth, built.tetrahedra.rows()));
+      VariantResult r = run_variant(run, built, path, settings);
       run.variants.push_back(std::move(r));
     } catch (const cases::InputError&) {
       throw;
@@ -408,6 +419,13 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       progress.stage("variant " + name + " failed: " + e.what());
     }
     progress.advance("variant " + name, i + 1, total, seconds_since(variants_start));
+  }
+  if (!settings.force_depth_curve) {
+    for (auto& v : run.variants)
+      v.force_depth.clear();
+    for (auto& load : run.other_tools)
+      for (auto& v : load.variants)
+        v.force_depth.clear();
   }
   if (run.variants.empty() && !run.failed_variants.empty())
     throw std::runtime_error("every variant failed; the first, " + run.failed_variants[0].first +

@@ -50,13 +50,11 @@ int calibrate_command(const Arguments& args) {
   request.quiet = opt.flag("quiet");
   request.compare_variants = !opt.flag("no-compare");
   request.overrides = overrides;
-  if (!opt.flag("no-cache"))
-    request.fem_cache_directory = std::filesystem::path(parameters.output.directory) / ".fem-cache";
-
   const std::filesystem::path final_dir =
       opt.value("out") ? std::filesystem::path(*opt.value("out"))
                        : std::filesystem::path(parameters.output.directory) /
                              (parameters.name + "-calibrate-" + run_timestamp());
+  if (!opt.flag("no-cache")) request.fem_cache_directory = fem_cache_beside(final_dir);
   std::ostringstream printed;
   bool converged = true;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {

@@ -72,7 +72,7 @@ int regress_command(const Arguments& args) {
     settings.force_depth_curve = false;
     settings.time_dynamics = false;
     settings.fem_cache_directory =
-        std::filesystem::path(parameters.output.directory) / ".fem-cache";
+        fem_cache_beside(std::filesystem::path(parameters.output.directory) / parameters.name);
     const CaseRun run = run_case(parameters, settings);
     if (opt.flag("update")) {
       const nlohmann::json old =

@@ -25,6 +25,9 @@ int run_command(const Arguments& args) {
                                               ? std::filesystem::path(*opt.value("out"))
                                               : std::filesystem::path(parameters.output.directory) /
                                                     (parameters.name + "-" + run_timestamp());
+  const std::optional<std::filesystem::path> cache =
+      opt.flag("no-cache") ? std::nullopt
+                           : std::optional<std::filesystem::path>(fem_cache_beside(final_dir));
   std::ostringstream printed;  // shown once the folder is in place
   std::vector<std::pair<std::string, std::string>> failed;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
@@ -32,9 +35,7 @@ int run_command(const Arguments& args) {
     settings.quiet = opt.flag("quiet");
     settings.force_depth_curve = !opt.flag("no-curve");
     settings.time_dynamics = !opt.flag("no-timing");
-    if (!opt.flag("no-cache"))
-      settings.fem_cache_directory =
-          std::filesystem::path(parameters.output.directory) / ".fem-cache";
+    settings.fem_cache_directory = cache;
     const CaseRun run = run_case(parameters, settings);
     failed = run.failed_variants;
     write_run_outputs(run, work_dir);

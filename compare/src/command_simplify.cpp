@@ -1,5 +1,6 @@
 // msfem simplify: bring a scanned organ surface down to the resolution a real-time model can step.
 #include <cstdio>
+#include <filesystem>
 
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/cases/surface_simplification.hpp"
@@ -20,6 +21,10 @@ int simplify_command(const Arguments& args) {
   if (smoothing < 0) throw std::invalid_argument("option --smooth must be >= 0");
   const std::string& in = opt.positional()[0];
   const std::string& out = opt.positional()[1];
+  std::error_code ignored;
+  if (std::filesystem::weakly_canonical(in, ignored) ==
+      std::filesystem::weakly_canonical(out, ignored))
+    throw std::invalid_argument("OUT '" + out + "' is the input file: simplify writes a new file");
 
   cases::Surface surface = cases::read_surface(in, unit);
   const auto before = cases::orient_and_validate(surface, /*check_self_intersections=*/false);

@@ -65,11 +65,11 @@ int sweep_command(const Arguments& args) {
                                               ? std::filesystem::path(*opt.value("out"))
                                               : std::filesystem::path(parameters.output.directory) /
                                                     (parameters.name + "-sweep-" + run_timestamp());
+  const std::filesystem::path cache = fem_cache_beside(final_dir);
   std::ostringstream printed;
   std::vector<std::pair<int, std::string>> failed;
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work) {
-    const SweepResult result = run_sweep(
-        parameters, settings, std::filesystem::path(parameters.output.directory) / ".fem-cache");
+    const SweepResult result = run_sweep(parameters, settings, cache);
     const auto& points = result.points;
     failed = result.failed_resolutions;
     const nlohmann::json j = sweep_json(parameters, result);

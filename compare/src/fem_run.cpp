@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
 
+#include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface.hpp"
 #include "msfem/cases/surface_refinement.hpp"
 #include "msfem/fem_reference/errors.hpp"
@@ -23,7 +25,61 @@ double mean_edge_length(const cases::Surface& s) {
   return sum / static_cast<double>(edges.size());
 }
 
+// Refuses, before meshing, a cell size that would mesh for hours and not fit in memory: the cells
+// a size gives (a regular tetrahedron of edge h has volume h³/6√2), the tools' refined balls too.
+void check_mesh_cost(const Problem& problem, const fem_reference::MeshOptions& options) {
+  const auto& p = problem.parameters;
+  auto cells = [](double volume, double h) { return 6 * std::sqrt(2.0) * volume / (h * h * h); };
+  double estimate = cells(std::abs(cases::signed_volume(problem.surface)), options.cell_size);
+  for (const auto& r : options.refinements)
+    estimate += cells(4.0 / 3.0 * M_PI * std::pow(r.radius, 3), r.cell_size);
+  const double dofs = 3.0 * estimate / 5.5 * (p.fem.degree == 2 ? 8.0 : 1.0);
+  if (dofs > max_reference_dofs) {
+    char message[256];
+    std::snprintf(message, sizeof message,
+                  ": fem/cell size %.3g m would mesh about %.3g M tetrahedra (%.3g M DoFs at "
+                  "P%d), above the %.3g M DoFs msfem solves; use a larger cell size",
+                  options.cell_size, estimate * 1e-6, dofs * 1e-6, p.fem.degree,
+                  max_reference_dofs * 1e-6);
+    throw cases::InputError(p.file.string() + message);
+  }
+}
+
 }  // namespace
+
+void check_no_rigid_motion(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool) {
+  std::optional<fem_reference::Support> tool_support;
+  if (tool) tool_support = tool_patch_support(*tool);
+  std::vector<Eigen::Vector3d> held;
+  int fixed = 0;
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d x = mesh.vertices.row(v).transpose();
+    fixed += problem.fixed_region(x);
+    if (problem.fixed_region(x) || (tool_support && tool_support->region(x))) held.push_back(x);
+  }
+  if (fixed == 0)
+    throw cases::InputError(problem.parameters.file.string() +
+                            ": support/fixed region: it catches no node of the FEM mesh; enlarge "
+                            "it (or move it) so that it holds part of the body");
+  double spread = 0.0;  // twice the largest triangle area among the held nodes, sampled
+  if (held.size() >= 3) {
+    const Eigen::Vector3d a = held.front();
+    const auto far = *std::max_element(held.begin(), held.end(), [&](const auto& p, const auto& q) {
+      return (p - a).squaredNorm() < (q - a).squaredNorm();
+    });
+    for (const auto& x : held)
+      spread = std::max(spread, (far - a).cross(x - a).norm());
+  }
+  const Eigen::Vector3d extent =
+      mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff();
+  if (!(spread > 1e-6 * extent.squaredNorm()))
+    throw cases::InputError(problem.parameters.file.string() + ": support/fixed region: it holds " +
+                            std::to_string(held.size()) + " node(s) of the FEM mesh" +
+                            (held.size() >= 3 ? ", all on one line" : "") +
+                            ", so the body can move or turn freely and the FEM is singular; "
+                            "enlarge the fixed region");
+}
 
 fem_reference::VolumeMesh mesh_problem(const Problem& problem,
                                        std::optional<std::vector<ToolPlacement>> refine_near) {
@@ -50,6 +106,7 @@ fem_reference::VolumeMesh mesh_problem(const Problem& problem,
   for (const ToolPlacement& t : tools)
     options.refinements.push_back(
         fem_reference::LocalRefinement{t.contact_point, 2 * t.radius, 2 * t.radius, tool_cell});
+  check_mesh_cost(problem, options);
   const cases::Surface& surface = refined ? *refined : problem.surface;
   return fem_reference::mesh_closed_surface(surface.vertices, surface.triangles, options);
 }
@@ -70,6 +127,7 @@ std::vector<bool> prescribed_surface_vertices(const Problem& problem,
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,
                       const std::optional<ToolPlacement>& tool) {
   const auto& p = problem.parameters;
+  check_no_rigid_motion(problem, mesh, tool);
   fem_reference::ElasticityModel model;
   model.degree = static_cast<unsigned>(p.fem.degree);
   model.material.youngs_modulus = p.material.youngs_modulus_pa;
@@ -122,6 +180,12 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
     fem = std::make_unique<fem_reference::ElasticityProblem>(mesh, model);
     fem->run();
     solution.solver = "cg_boomeramg (cg_gamg failed: " + std::string(e.what()) + ")";
+    // A fallback's answer is trusted only if it is in equilibrium.
+    if (!(fem->equilibrium_defect() < 1e-6))
+      throw fem_reference::SolverError(
+          "the FEM reference is not in equilibrium after the BoomerAMG fallback (|Σ reactions + "
+          "loads| / |loads| = " +
+          std::to_string(fem->equilibrium_defect()) + "): " + e.what());
   }
   const fem_reference::ElasticityProblem& fem_solved = *fem;
   solution.vertex_displacement = fem_solved.vertex_displacements();

@@ -22,13 +22,18 @@ const std::vector<CommandEntry>& commands() {
   static const std::vector<CommandEntry> table = {
       {"run", run_command,
        "run CASE.prm [--out DIR] [--set SECTION/KEY=VALUE]... [--quiet] [--json] [--no-curve]\n"
+       "          [--no-timing] [--no-cache]\n"
        "      the FEM and every mass-spring variant on the case; summary.json, report.md, VTU, "
-       "HDF5"},
+       "HDF5\n"
+       "      (--no-curve: no force-depth curve; --no-timing: no dynamics timed; --no-cache: "
+       "solve\n"
+       "      the FEM even if <output directory>/.fem-cache holds it)"},
       {"sweep", sweep_command,
        "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
+       "          [--quiet] [--json]\n"
        "      variants x resolutions x integrators: sweep.json, table and Pareto plot"},
       {"regress", regress_command,
-       "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]...\n"
+       "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]... [--quiet]\n"
        "      compare runs with committed baselines; exit 1 on a worse metric or field, a missing\n"
        "      or stale baseline, or a non-finite value"},
       {"calibrate", calibrate_command,
@@ -36,6 +41,7 @@ const std::vector<CommandEntry>& commands() {
        "LOADS]\n"
        "          [--out DIR] [--set K=V]... [--max-evaluations N] [--strict] [--json] "
        "[--no-compare]\n"
+       "          [--no-cache] [--quiet]\n"
        "      fit spring-group stiffness to the FEM on training loads (DX,DY,DZ@DEPTH;...), check\n"
        "      on held-out loads; calibration.json, report.md, calibrated.prm"},
       {"params", params_command, "params\n      print the whole case-file language"},
@@ -44,12 +50,14 @@ const std::vector<CommandEntry>& commands() {
        "            mesh-info --generate icosphere:LEVEL[:RADIUS_M] | ellipsoid:LEVEL:A:B:C\n"
        "      counts, volume, bounding box, genus and every defect; exit 1 on a defect"},
       {"simplify", simplify_command,
-       "simplify IN OUT --vertices N [--unit m|cm|mm] [--smooth ITERATIONS]\n"
+       "simplify IN OUT --vertices N [--unit m|cm|mm] [--smooth ITERATIONS] [--binary]\n"
        "      edge-collapse to exactly N vertices (then Taubin smoothing), written in IN's unit"},
       {"bench", bench_command,
-       "bench massspring [--json]\n      stepping speed of the mass-spring models"},
+       "bench massspring [--json] [--mesh-dir DIR] [--threads N] [--samples N] [--seconds S]\n"
+       "          [--float] [--no-10x]\n"
+       "      stepping speed of the mass-spring models"},
       {"verify", verify_command,
-       "verify [--json]\n      the FEM reference against closed-form solutions"},
+       "verify [--json] [--no-locking]\n      the FEM reference against closed-form solutions"},
   };
   return table;
 }
@@ -58,6 +66,23 @@ void print_usage(std::FILE* out) {
   std::fprintf(out, "usage: msfem COMMAND [ARGS]\n\ncommands:\n");
   for (const auto& c : commands())
     std::fprintf(out, "  %s\n", c.usage);
+}
+
+bool wants_help(const std::vector<std::string>& args) {
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") return true;
+  return false;
+}
+
+// A result a script cannot read is not a success: a full disk or a closed pipe on standard output
+// turns exit 0 into 1.
+int finish(const std::string& name, int code) {
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::cerr << "msfem " << name << ": failed: cannot write to standard output\n";
+    return code == 0 ? 1 : code;
+  }
+  return code;
 }
 
 }  // namespace
@@ -72,8 +97,12 @@ int main(int argc, char** argv) {
   args.erase(args.begin());
   for (const auto& c : commands()) {
     if (name != c.name) continue;
+    if (wants_help(args)) {
+      std::printf("usage: msfem %s\n", c.usage);
+      return finish(name, 0);
+    }
     try {
-      return c.run(args);
+      return finish(name, c.run(args));
     } catch (const msfem::cases::InputError& e) {
       std::cerr << "msfem " << name << ": error: " << e.what() << '\n';
       return 2;

@@ -2,21 +2,46 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <iostream>
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/cases/surface_simplification.hpp"
 #include "msfem/cases/surface_validation.hpp"
+#include "msfem/cases/units.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
 
 namespace msfem::compare {
 namespace {
 
+// A surface in millimetres read as metres is a 100 m organ that meshes and solves without error:
+// say so (on stderr and in the report) when the size is outside what an organ or a tissue sample
+// can be.
+void warn_if_not_organ_sized(const cases::CaseParameters& p, const cases::Surface& s,
+                             std::vector<std::string>& notes) {
+  const Eigen::Matrix<double, 2, 3> box = cases::bounding_box(s);
+  const double size = (box.row(1) - box.row(0)).maxCoeff();
+  if (size >= 1e-3 && size <= 1.0) return;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the surface spans %.3g m (geometry/unit = %s): organs are 1 mm to 1 m; is the "
+                "unit right?",
+                size, cases::to_string(p.geometry.unit).c_str());
+  notes.push_back(text);
+  std::cerr << "msfem: warning: " << p.file.string() << ": " << text << "\n";
+}
+
 cases::Surface load_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
   const auto& g = p.geometry;
   cases::Surface s = cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
                                                            : cases::read_surface(g.source, g.unit);
+  if (g.simplify_to_vertices > s.num_vertices())
+    throw cases::InputError(p.file.string() + ": geometry/simplify to vertices = " +
+                            std::to_string(g.simplify_to_vertices) + " is more than the " +
+                            std::to_string(s.num_vertices()) + " vertices of " + g.source +
+                            " (simplification only removes vertices; 0 keeps the surface)");
   if (g.simplify_to_vertices > 0 && g.simplify_to_vertices < s.num_vertices()) {
     const auto before = s.num_vertices();
     try {
@@ -34,6 +59,7 @@ cases::Surface load_surface(const cases::CaseParameters& p, std::vector<std::str
   if (!report.ok())
     throw cases::InputError(p.file.string() + ": surface " + g.source + " is not a valid closed " +
                             "surface: " + report.defects.front().message);
+  warn_if_not_organ_sized(p, s, notes);
   return s;
 }
 

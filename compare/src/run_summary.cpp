@@ -261,13 +261,12 @@ std::string table_notes(const CaseRun& run) {
   const LoadErrorEstimate first = e.loads.empty() ? LoadErrorEstimate{} : e.loads.front();
   if (first.rel_l2_error) {
     char line[512];
-    std::snprintf(line, sizeof line,
-                  "FEM reference's own error (%s; %zu DoFs, %.1f s): rel L2 %.4f, %s %s\n",
-                  e.note.c_str(), e.dofs, e.time_s, *first.rel_l2_error,
-                  run.problem.tools.empty() && !patch_vertices(run.problem).empty()
-                      ? "patch displacement"
-                      : "force",
-                  first.force_rel_error ? error_cell(*first.force_rel_error, false).c_str() : "-");
+    std::snprintf(
+        line, sizeof line, "FEM reference's own error (%s; %zu DoFs, %.1f s): rel L2 %.4f, %s %s\n",
+        e.note.c_str(), e.dofs, e.time_s, *first.rel_l2_error,
+        run.problem.tools.empty() && !patch_vertices(run.problem).empty() ? "patch displacement"
+                                                                          : "force",
+        first.force_rel_error ? error_cell(*first.force_rel_error, false).c_str() : "-");
     out << line;
     if (std::any_of(run.variants.begin(), run.variants.end(),
                     [&](const auto& v) { return !unresolved_metrics(run, v).empty(); }))

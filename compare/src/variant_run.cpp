@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <set>
 #include <stdexcept>
 
 #include "cholmod_factor.hpp"
@@ -142,6 +144,53 @@ const std::vector<std::string>& known_variants() {
   static const std::vector<std::string> names = {"three_tier", "single_layer", "tet_edges",
                                                  "skeleton"};
   return names;
+}
+
+const std::vector<std::string>& spring_groups_of(const std::string& variant) {
+  static const std::map<std::string, std::vector<std::string>> groups = {
+      {"three_tier",
+       {"tier1_edges", "tier2_edges", "tier12_diagonals", "tier12_radial", "tier23_radial"}},
+      {"single_layer", {"surface_edges"}},
+      {"tet_edges", {"tet_edges"}},
+      {"skeleton", {"surface_edges", "skeleton_edges", "links"}}};
+  static const std::vector<std::string> none;
+  const auto it = groups.find(variant);
+  return it == groups.end() ? none : it->second;
+}
+
+void check_variant_names(const cases::CaseParameters& p) {
+  const auto& known = known_variants();
+  std::set<std::string> groups;
+  for (const auto& v : p.mass_spring.variants) {
+    if (std::find(known.begin(), known.end(), v) == known.end())
+      throw cases::InputError(p.file.string() + ": mass spring/variants: unknown variant '" + v +
+                              "'");
+    groups.insert(spring_groups_of(v).begin(), spring_groups_of(v).end());
+  }
+  if (p.mass_spring.volume_preservation) groups.insert(volume_group);
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (!groups.count(group)) {
+      std::string list;
+      for (const auto& g : groups)
+        list += (list.empty() ? "" : ", ") + g;
+      throw cases::InputError(
+          p.file.string() + ": mass spring/group scales: no variant of the case has a group '" +
+          group + "'" +
+          (group == volume_group ? " (it needs mass spring/volume preservation = true)" : "") +
+          "; the case's groups: " + list);
+    }
+}
+
+void check_variants_fit(const Problem& problem) {
+  const auto& p = problem.parameters;
+  const auto& variants = p.mass_spring.variants;
+  const int n = static_cast<int>(problem.surface.num_vertices());
+  if (std::find(variants.begin(), variants.end(), "skeleton") != variants.end() &&
+      p.mass_spring.skeleton_control_points > n)
+    throw cases::InputError(p.file.string() + ": mass spring/skeleton/control points = " +
+                            std::to_string(p.mass_spring.skeleton_control_points) +
+                            " is more than the surface's " + std::to_string(n) +
+                            " vertices (the control mesh is a simplified copy of the surface)");
 }
 
 void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool) {

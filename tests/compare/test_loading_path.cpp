@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "msfem/cases/case_parameters.hpp"
 #include "msfem/compare/case_run.hpp"
 #include "msfem/compare/variant_run.hpp"
 #include "msfem/massspring/topology_builders.hpp"
@@ -63,6 +64,24 @@ TEST(InvertedTetrahedra, NoneForAVariantWithoutVolumeElements) {
   BuiltVariant b = one_tetrahedron();
   b.tetrahedra.resize(0, 4);
   EXPECT_FALSE(inverted_tetrahedra(b, Eigen::VectorXd::Zero(12)).has_value());
+}
+
+}  // namespace
+}  // namespace msfem::compare
+
+namespace msfem::compare {
+namespace {
+
+// The case checks group scales against spring_groups_of before anything is built: the list must
+// be exactly what each builder makes.
+TEST(SpringGroups, TheListedGroupsAreWhatEachVariantBuilds) {
+  const auto parameters = cases::read_case(std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm");
+  const Problem problem = make_problem(parameters);
+  const auto mesh = mesh_problem(problem);
+  for (const auto& name : known_variants()) {
+    const BuiltVariant built = build_variant(name, problem, mesh, problem.tools.front());
+    EXPECT_EQ(built.model->network().spring_group_names, spring_groups_of(name)) << name;
+  }
 }
 
 }  // namespace

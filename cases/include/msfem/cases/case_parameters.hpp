@@ -89,7 +89,7 @@ struct MassSpringParameters {
   double inner_tier_scale = 2.0;
   std::string inner_tiers = "scaled";  ///< scaled | offset (along the inward normal)
   int skeleton_control_points = 0;     ///< 0: a tenth of the surface vertices, at least 20
-  double skeleton_draw_factor = 0.5;   ///< control points drawn toward the centroid by this factor
+  double skeleton_draw_factor = 0.45;  ///< control points drawn toward the centroid by this factor
 };
 
 struct FemParameters {

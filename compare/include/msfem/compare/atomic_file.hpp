@@ -22,8 +22,14 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 
 /// Creates `directory` with everything `fill` writes into the temporary folder it is given, renamed
 /// into place only when `fill` returns: a failed run leaves no folder behind. Throws
-/// cases::InputError if `directory` exists and is not empty; rethrows whatever `fill` throws.
+/// cases::InputError, before `fill` runs, if `directory` is empty, exists and is not empty, or its
+/// temporary cannot be created there; rethrows whatever `fill` throws.
 void fill_directory_atomically(const std::filesystem::path& directory,
                                const std::function<void(const std::filesystem::path& work)>& fill);
+
+/// The FEM cache of a command whose results go to `run_folder`: `.fem-cache` in the folder that
+/// holds it (so `--out DIR` keeps its cache beside DIR, not in the working directory). Created now:
+/// a place that cannot be written is a cases::InputError before any solve.
+std::filesystem::path fem_cache_beside(const std::filesystem::path& run_folder);
 
 }  // namespace msfem::compare

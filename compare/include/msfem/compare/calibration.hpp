@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "msfem/cases/case_parameters.hpp"
+#include "msfem/compare/fem_error_estimate.hpp"
 #include "msfem/compare/problem.hpp"
 #include "msfem/compare/variant_run.hpp"
 
@@ -27,6 +28,7 @@ struct LoadReference {
   Eigen::MatrixX3d surface_displacement;  ///< n_surface x 3, m
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
   std::vector<int> compared_vertices;  ///< surface vertices no support or tool prescribes
+  LoadErrorEstimate fem_error;         ///< the reference's own error at this load (if estimated)
 };
 
 /// The three errors of one load (DESIGN's definitions).

@@ -12,8 +12,14 @@
 
 namespace msfem::compare {
 
+/// The largest reference msfem meshes and solves (estimated from the volume and cell sizes before
+/// meshing): 6 M DoFs, about 20 GB with PETSc's AMG.
+inline constexpr double max_reference_dofs = 6e6;
+
 /// The tetrahedral mesh of the problem's surface (its vertices kept as mesh vertices 0..n-1), sized
 /// by fem/cell size and refined near the given tools (none given: near the first of the problem's).
+/// Throws cases::InputError, before meshing, when the cell sizes would give more than
+/// max_reference_dofs.
 fem_reference::VolumeMesh mesh_problem(
     const Problem& problem, std::optional<std::vector<ToolPlacement>> refine_near = std::nullopt);
 
@@ -25,6 +31,13 @@ struct FemSolution {
   fem_reference::SolveStatistics statistics;
   std::string solver;  ///< the solver that produced it (the case's, or the fallback and why)
 };
+
+/// Throws cases::InputError naming the case file and support/fixed region when the fixed region
+/// catches no node of `mesh`, or the held nodes (fixed, and the tool's) leave the body free to move
+/// or turn: the stiffness matrix would be singular, and an iterative solver returns garbage
+/// instead of failing. solve_fem checks it; a command checks it once before its first solve.
+void check_no_rigid_motion(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool);
 
 /// Solves the problem's FEM for `tool` (none: gravity and patch force only).
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,

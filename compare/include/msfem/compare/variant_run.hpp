@@ -17,6 +17,19 @@ namespace msfem::compare {
 /// The variants a case may name.
 const std::vector<std::string>& known_variants();
 
+/// The spring groups each variant's builder makes (tests check the list against the built
+/// networks), for checking a case's names before anything is solved.
+const std::vector<std::string>& spring_groups_of(const std::string& variant);
+
+/// Throws cases::InputError naming the case file and key for a variant msfem does not have, and
+/// for a `mass spring/group scales` group that none of the case's variants has (or `volume`
+/// without volume preservation): a misspelled group would otherwise leave the run unscaled.
+void check_variant_names(const cases::CaseParameters& parameters);
+
+/// Throws cases::InputError naming the case file and key for a variant setting the problem's
+/// surface cannot give (more skeleton control points than surface vertices).
+void check_variants_fit(const Problem& problem);
+
 /// The name under which `mass spring/group scales` and msfem calibrate scale the volume
 /// preservation modulus (`mass spring/volume preservation`).
 inline constexpr const char* volume_group = "volume";

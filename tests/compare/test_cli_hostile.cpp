@@ -1,0 +1,141 @@
+// Hostile input, as a user gives it: every case is refused with exit 2, one error line naming the
+// file, line or key at fault, no result folder, and no FEM solve before the check that refuses it.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "cli_runner.hpp"
+
+namespace msfem {
+namespace {
+
+using testing::run_msfem;
+using testing::TemporaryDirectory;
+
+const std::string cases_dir = MSFEM_CASES_DIR;
+const std::string sphere = cases_dir + "/sphere_indent.prm";
+
+struct Hostile {
+  const char* name;
+  std::string args;      ///< after "msfem", with {dir} for the test's folder
+  const char* expected;  ///< what the error line must name
+};
+
+class HostileInput : public ::testing::TestWithParam<Hostile> {};
+
+void write(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+std::string replace_dir(std::string s, const std::string& dir) {
+  for (auto at = s.find("{dir}"); at != std::string::npos; at = s.find("{dir}"))
+    s.replace(at, 5, dir);
+  return s;
+}
+
+TEST_P(HostileInput, IsRefusedAtOnceNamingTheFault) {
+  const Hostile& h = GetParam();
+  TemporaryDirectory dir;
+  write(dir / "self.prm", "include self.prm\n");
+  write(dir / "a.prm", "include " + (dir / "b.prm").string() + "\n");
+  write(dir / "b.prm", "include " + (dir / "a.prm").string() + "\n");
+  write(dir / "twice.prm",
+        "subsection material\n  set youngs modulus = 3000\n  set youngs  modulus = 4000\nend\n");
+  write(dir / "empty.prm", "");
+  const auto out = dir / "out";
+  const std::string args = replace_dir(h.args, dir.path().string());
+  // simplify writes a file, not a folder, and takes no --out.
+  const bool folder = args.find("--out") == std::string::npos && args.rfind("simplify", 0) != 0;
+  const auto r = run_msfem(args + (folder ? " --out " + out.string() : std::string()));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  std::size_t error_lines = 0;
+  std::string error;
+  std::istringstream lines(r.err);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find(": error: ") != std::string::npos) {
+      ++error_lines;
+      error = line;
+    }
+  EXPECT_EQ(error_lines, 1u) << r.err;
+  EXPECT_NE(error.find(h.expected), std::string::npos) << error;
+  EXPECT_EQ(r.err.find("solving the FEM"), std::string::npos) << "solved before refusing";
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+const Hostile hostile[] = {
+    {"SelfInclude", "run {dir}/self.prm", "self.prm:1: include"},
+    {"MutualInclude", "run {dir}/a.prm", "includes itself"},
+    {"KeySetTwice", "run {dir}/twice.prm", "twice.prm:3: 'material/youngs modulus' is set twice"},
+    {"EmptyCaseFile", "run {dir}/empty.prm", "empty.prm: the case file is empty"},
+    {"DirectoryAsCase", "run {dir}", "is a directory"},
+    {"CellSizeThatWouldMeshForever", "run " + sphere + " --set 'fem/cell size=1e-4'",
+     "fem/cell size 0.0001 m would mesh about"},
+    {"MisspelledGroupScale", "run " + sphere + " --set 'mass spring/group scales=tier1_edgez:2'",
+     "mass spring/group scales: no variant of the case has a group 'tier1_edgez'"},
+    {"VolumeScaleWithoutVolume", "run " + sphere + " --set 'mass spring/group scales=volume:2'",
+     "volume preservation = true"},
+    {"AbsurdModulus", "run " + sphere + " --set 'material/youngs modulus=1e300'",
+     "material/youngs modulus=1e300"},
+    {"SimplifyAboveTheVertexCount", "run " + sphere + " --set 'geometry/simplify to vertices=5000'",
+     "geometry/simplify to vertices = 5000 is more than the 642 vertices"},
+    {"MoreControlPointsThanVertices",
+     "run " + sphere + " --set 'mass spring/skeleton/control points=5000'",
+     "mass spring/skeleton/control points = 5000"},
+    {"FixedRegionCatchingNoNode", "run " + sphere + " --set 'support/inner core scale=50'",
+     "support/fixed region: it catches no node"},
+    {"UnknownIntegrator", "run " + sphere + " --set 'timing/integrator=verlet'", "verlet"},
+    {"ErrorEstimateDegreeAtP2", "run " + sphere + " --set 'fem/error estimate=degree'",
+     "fem/error estimate = degree needs fem/degree = 1"},
+    {"UnknownFitGroup", "calibrate " + sphere + " --fit nope", "has no group 'nope'"},
+    {"HeldOutLoadOnATrainingVertex",
+     "calibrate " + sphere + " --train '0,0,1@0.005' --test '0,0.001,1@0.005'",
+     "presses the same surface vertex"},
+    {"EmptyOutPath", "run " + sphere + " --out ''", "empty path"},
+    {"SimplifyOntoItsInput",
+     "simplify " + cases_dir + "/data/pancreas_vh_female_m.obj " + cases_dir +
+         "/data/pancreas_vh_female_m.obj --vertices 446",
+     "is the input file"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Cli, HostileInput, ::testing::ValuesIn(hostile),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(CliInterface, EveryCommandPrintsItsOptionsWithHelp) {
+  for (const char* command : {"run", "sweep", "regress", "calibrate", "params", "mesh-info",
+                              "simplify", "bench", "verify"}) {
+    const auto r = run_msfem(std::string(command) + " --help");
+    EXPECT_EQ(r.exit_code, 0) << command << r.err;
+    EXPECT_NE(r.out.find(std::string("usage: msfem ") + command), std::string::npos) << r.out;
+  }
+  const auto run = run_msfem("run --help");
+  for (const char* option : {"--no-timing", "--no-cache", "--no-curve", "--set", "--out"})
+    EXPECT_NE(run.out.find(option), std::string::npos) << option;
+}
+
+TEST(CliInterface, AFullStandardOutputIsAFailure) {
+  const int status =
+      std::system((std::string(MSFEM_EXECUTABLE) + " params > /dev/full 2>/dev/null").c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+}
+
+// The printed language is a case: `msfem params > x.prm && msfem run x.prm` runs (P1 and no
+// estimate here, to keep it short; every key else as printed).
+TEST(CliInterface, ThePrintedDefaultsRun) {
+  TemporaryDirectory dir;
+  const auto params = run_msfem("params");
+  ASSERT_EQ(params.exit_code, 0);
+  write(dir / "defaults.prm", params.out);
+  const auto r = run_msfem("run " + (dir / "defaults.prm").string() +
+                           " --quiet --no-timing --no-curve --set fem/degree=1 --set "
+                           "'fem/error estimate=none' --out " +
+                           (dir / "run").string());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+}  // namespace
+}  // namespace msfem
