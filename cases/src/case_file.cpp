@@ -415,8 +415,10 @@ CaseParameters extract(ParameterHandler& prm) {
 // Declares the language, parses the file and applies the overrides.
 void load_case(const std::filesystem::path& file, const std::vector<std::string>& overrides,
                ParameterHandler& prm) {
-  std::istringstream in(checked_case_text(file));
   declare_all(prm);
+  std::ostringstream language;
+  prm.print_parameters(language, ParameterHandler::OutputStyle::ShortPRM);
+  std::istringstream in(checked_case_text(file, subsection_paths(language.str())));
   try {
     prm.parse_input(in, file.string(), "", /*skip_undefined=*/false);
   } catch (const dealii::ExceptionBase& e) {

@@ -43,18 +43,25 @@ bool starts_with_word(const std::string& line, const std::string& word) {
   return line.size() == word.size() || line[word.size()] == ' ';
 }
 
+std::string without_byte_order_mark(std::string text, const fs::path& file,
+                                    const std::string& where) {
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
+  if (trim(text).empty()) throw InputError(where + file.string() + ": the case file is empty");
+  return text;
+}
+
 std::string file_text(const fs::path& file, const std::string& where) {
   std::error_code ec;
   if (fs::is_directory(file, ec))
     throw InputError(where + file.string() + ": is a directory, not a case file");
+  // A device or a pipe (an include of /dev/zero) would be read forever.
+  if (fs::exists(file, ec) && !fs::is_regular_file(file, ec))
+    throw InputError(where + file.string() + ": is not a regular file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(where + file.string() + ": cannot open case file");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  std::string text = buffer.str();
-  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte-order mark
-  if (trim(text).empty()) throw InputError(where + file.string() + ": the case file is empty");
-  return text;
+  return without_byte_order_mark(buffer.str(), file, where);
 }
 
 // One file's lines (continuations joined as ParameterHandler joins them), with their numbers.
@@ -79,9 +86,10 @@ std::vector<std::pair<int, std::string>> logical_lines(const std::string& text) 
 }
 
 struct Scan {
-  std::vector<fs::path> stack;                // the include chain, outermost first
-  std::map<std::string, std::string> set_at;  // "section/.../key" -> "file:line"
-  std::vector<std::string> sections;          // the subsection path at this point
+  const std::set<std::string>* known = nullptr;  // the language's subsection paths
+  std::vector<fs::path> stack;                   // the include chain, outermost first
+  std::map<std::string, std::string> set_at;     // "section/.../key" -> "file:line"
+  std::vector<std::string> sections;             // the subsection path at this point
 };
 
 std::string section_key(const std::vector<std::string>& sections, const std::string& key) {
@@ -92,6 +100,27 @@ std::string section_key(const std::vector<std::string>& sections, const std::str
 }
 
 void scan_file(const fs::path& file, const std::string& text, Scan& scan);
+
+std::string joined(const std::vector<std::string>& sections) {
+  std::string path;
+  for (const auto& s : sections)
+    path += (path.empty() ? "" : "/") + s;
+  return path;
+}
+
+void check_section(const Scan& scan, const std::string& where) {
+  const std::string path = joined(scan.sections);
+  if (scan.sections.empty() || scan.known->count(path)) return;
+  const std::vector<std::string> parent(scan.sections.begin(), scan.sections.end() - 1);
+  const std::string prefix = parent.empty() ? "" : joined(parent) + "/";
+  std::string known;
+  for (const auto& s : *scan.known)
+    if (s.rfind(prefix, 0) == 0 && s.find('/', prefix.size()) == std::string::npos)
+      known += (known.empty() ? "" : ", ") + s.substr(prefix.size());
+  throw InputError(where + "unknown subsection '" + path + "' (" +
+                   (parent.empty() ? "sections" : "subsections of " + joined(parent)) + ": " +
+                   known + ")");
+}
 
 void scan_include(const fs::path& included, const std::string& where, Scan& scan) {
   const fs::path canonical = fs::weakly_canonical(included);
@@ -112,6 +141,7 @@ void scan_file(const fs::path& file, const std::string& text, Scan& scan) {
     const std::string where = file.string() + ":" + std::to_string(number) + ": ";
     if (starts_with_word(line, "subsection")) {
       scan.sections.push_back(trim(line.substr(10)));
+      check_section(scan, where);
     } else if (starts_with_word(line, "end")) {
       if (!scan.sections.empty()) scan.sections.pop_back();  // deal.II reports the imbalance
     } else if (starts_with_word(line, "include")) {
@@ -146,9 +176,32 @@ std::string with_absolute_includes(const fs::path& file, const std::string& text
 
 }  // namespace
 
-std::string checked_case_text(const fs::path& file) {
-  const std::string text = with_absolute_includes(file, file_text(file, ""));
+std::set<std::string> subsection_paths(const std::string& printed_parameters) {
+  std::set<std::string> paths;
+  std::vector<std::string> stack;
+  std::istringstream in(printed_parameters);
+  for (std::string raw; std::getline(in, raw);) {
+    const std::string line = normalised(raw);
+    if (starts_with_word(line, "subsection")) {
+      stack.push_back(trim(line.substr(10)));
+      paths.insert(joined(stack));
+    } else if (starts_with_word(line, "end") && !stack.empty()) {
+      stack.pop_back();
+    }
+  }
+  return paths;
+}
+
+std::string checked_case_text(const fs::path& file, const std::set<std::string>& sections) {
+  return checked_case_text(file, file_text(file, ""), sections);
+}
+
+std::string checked_case_text(const fs::path& file, const std::string& contents,
+                              const std::set<std::string>& sections) {
+  const std::string text =
+      with_absolute_includes(file, without_byte_order_mark(contents, file, ""));
   Scan scan;
+  scan.known = &sections;
   scan_file(file, text, scan);
   return text;
 }

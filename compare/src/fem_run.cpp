@@ -168,8 +168,9 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
 
   FemSolution solution;
   solution.solver = p.fem.solver;
-  auto fem = std::make_unique<fem_reference::ElasticityProblem>(mesh, model);
+  std::unique_ptr<fem_reference::ElasticityProblem> fem;
   try {
+    fem = std::make_unique<fem_reference::ElasticityProblem>(mesh, model);
     fem->run();
   } catch (const fem_reference::SolverError& e) {
     // GAMG's smoothers can turn indefinite on a graded mesh (the tool refinement's); BoomerAMG
@@ -186,6 +187,14 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
           "the FEM reference is not in equilibrium after the BoomerAMG fallback (|Σ reactions + "
           "loads| / |loads| = " +
           std::to_string(fem->equilibrium_defect()) + "): " + e.what());
+  } catch (const std::invalid_argument& e) {
+    // The FEM's own input checks (a support or traction that catches nothing) in the case's words.
+    const std::string what = e.what();
+    const char* key = what.find("'tool'") != std::string::npos    ? "loads/tool"
+                      : what.find("'fixed'") != std::string::npos ? "support/fixed region"
+                      : what.find("'patch'") != std::string::npos ? "loads/patch force"
+                                                                  : "fem";
+    throw cases::InputError(p.file.string() + ": " + key + ": " + what);
   }
   const fem_reference::ElasticityProblem& fem_solved = *fem;
   solution.vertex_displacement = fem_solved.vertex_displacements();

@@ -72,8 +72,12 @@ void compare_field(const std::string& case_name, const VariantResult& v, const n
     const auto& f = base.at("field");
     reference = read_h5_matrix(fields_file, f.at("dataset").get<std::string>());
   } catch (const std::exception& e) {
+    // A file that is there but cannot be read (truncated, not HDF5, the dataset gone) is corrupt,
+    // not missing: the fix is different (restore it, not write it).
     row.baseline = fields_file.filename().string();
-    row.status = "MISSING";
+    const bool present = std::filesystem::is_regular_file(fields_file);
+    row.status = present ? "CORRUPT" : "MISSING";
+    if (present) row.now = std::string("unreadable: ") + e.what();
     rows.push_back(row);
     return;
   }

@@ -180,5 +180,31 @@ TEST_F(CaseFile, ErrorEstimateMethodsAndTheirLimits) {
   EXPECT_NE(error_of(p, {"fem/error estimate=coarsen"}), "");
 }
 
+TEST_F(CaseFile, AMisspelledSectionIsNamedNotItsFirstKey) {
+  const auto p = write("c.prm", "subsection materail\n  set youngs modulus = 2000\nend\n");
+  const std::string error = error_of(p);
+  EXPECT_NE(error.find("c.prm:1: unknown subsection 'materail'"), std::string::npos) << error;
+  EXPECT_NE(error.find("material"), std::string::npos) << error;  // the sections it could be
+  const auto nested =
+      write("n.prm", "subsection loads\n  subsection tol\n    set radius = 0.01\n  end\nend\n");
+  EXPECT_NE(
+      error_of(nested).find("n.prm:2: unknown subsection 'loads/tol' (subsections of loads: "),
+      std::string::npos)
+      << error_of(nested);
+}
+
+TEST_F(CaseFile, AByteOrderMarkAndIncludesRelativeToTheCaseFile) {
+  const auto p = write("bom.prm", "\xEF\xBB\xBFsubsection material\n  set density = 1000\nend\n");
+  EXPECT_EQ(read_case(p).material.density_kg_per_m3, 1000.0);
+  std::filesystem::create_directories(dir_ / "sub");
+  write("sub/part.prm", "subsection material\n  set density = 900\nend\n");
+  const auto main = write("sub/main.prm", "include part.prm\n");
+  const auto cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir_);  // not the case file's folder
+  const double density = read_case(main).material.density_kg_per_m3;
+  std::filesystem::current_path(cwd);
+  EXPECT_EQ(density, 900.0);
+}
+
 }  // namespace
 }  // namespace msfem::cases

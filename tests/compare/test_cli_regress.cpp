@@ -109,6 +109,15 @@ TEST_F(Regress, MissingFieldsFileFails) {
   EXPECT_NE(r.out.find("MISSING"), std::string::npos) << r.out;
 }
 
+TEST_F(Regress, TruncatedFieldsFileIsCorruptNotMissing) {
+  const auto fields = tmp_ / "baselines" / "small_sphere.fields.h5";
+  std::filesystem::resize_file(fields, std::filesystem::file_size(fields) / 2);
+  const auto r = regress();
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("CORRUPT"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("MISSING"), std::string::npos) << r.out;
+}
+
 TEST_F(Regress, VariantWithoutReferenceFails) {
   auto j = nlohmann::json::parse(read_text(baseline_file()));
   j["variants"].erase("skeleton");

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz) with clang, seeds each corpus from the project's own
+# files (cases/data surfaces by format, cases/*.prm) and runs each target for a bounded time:
+#   bash scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 60)
+# Exits non-zero on the first crash, leak, hang (-timeout) or sanitizer report; the input that
+# caused it is left in build-fuzz/ as crash-*, leak-* or timeout-*.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+CC=clang CXX=clang++ cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build-fuzz -j "${MSFEM_JOBS:-2}"
+for format in obj stl off ply case; do
+  corpus=build-fuzz/corpus/$format
+  mkdir -p "$corpus"
+  if [ "$format" = case ]; then
+    cp cases/*.prm tests/compare/data/*.prm "$corpus"/
+  else
+    # Small seeds only: libFuzzer mutates them, and -max_len caps what it grows them to.
+    find cases/data tests -name "*.$format" -size -200k -exec cp {} "$corpus"/ \; 2>/dev/null || true
+  fi
+  echo "== fuzz_$format: ${seconds} s"
+  (cd build-fuzz && ./fuzz_$format -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+     -max_len=65536 -print_final_stats=1 "corpus/$format" 2>&1 | grep -E "^(#[0-9]+ *DONE|stat::number_of_executed_units|==[0-9]+==ERROR|SUMMARY)" || true)
+  if ls build-fuzz/crash-* build-fuzz/leak-* build-fuzz/timeout-* >/dev/null 2>&1; then
+    echo "fuzz_$format found a defect: $(ls build-fuzz/crash-* build-fuzz/leak-* build-fuzz/timeout-* 2>/dev/null)" >&2
+    exit 1
+  fi
+done
