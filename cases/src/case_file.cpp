@@ -25,6 +25,7 @@ namespace {
 using dealii::ParameterHandler;
 namespace Patterns = dealii::Patterns;
 
+const char* const default_output_directory = "results/runs";
 const char* const variant_names = "three_tier|single_layer|tet_edges|skeleton";
 
 Patterns::List point_pattern() {
@@ -187,8 +188,10 @@ void declare_fem_timing_output(ParameterHandler& prm) {
   prm.declare_entry("steps", "2000", Patterns::Integer(1, 100000000), "Dynamic steps timed.");
   prm.leave_subsection();
   prm.enter_subsection("output");
-  prm.declare_entry("directory", "results/runs", Patterns::Anything(),
-                    "Folder under which each run writes <case>-<time>/.");
+  prm.declare_entry("directory", default_output_directory, Patterns::Anything(),
+                    "Folder under which each run writes <case>-<time>/ (and its .fem-cache); "
+                    "relative to the case file when set in it, to the working directory when "
+                    "left at the default or given with --set.");
   prm.leave_subsection();
 }
 
@@ -424,8 +427,18 @@ void load_case(const std::filesystem::path& file, const std::vector<std::string>
   } catch (const dealii::ExceptionBase& e) {
     throw InputError(one_line(e));
   }
+  // A relative output/directory written in the case file is relative to the case file, as every
+  // path in it is; one given with --set (or the default) is relative to the working directory.
+  prm.enter_subsection("output");
+  const std::string written = prm.get("directory");
+  prm.leave_subsection();
   for (const auto& o : overrides)
     apply_override(prm, o);
+  prm.enter_subsection("output");
+  const std::filesystem::path directory = prm.get("directory");
+  if (directory == written && written != default_output_directory && directory.is_relative())
+    prm.set("directory", (file.parent_path() / directory).lexically_normal().string());
+  prm.leave_subsection();
 }
 
 }  // namespace

@@ -206,5 +206,13 @@ TEST_F(CaseFile, AByteOrderMarkAndIncludesRelativeToTheCaseFile) {
   EXPECT_EQ(density, 900.0);
 }
 
+TEST_F(CaseFile, OutputDirectoryWrittenInTheCaseIsRelativeToIt) {
+  const auto p = write("c.prm", "subsection output\n  set directory = mine\nend\n");
+  EXPECT_EQ(read_case(p).output.directory, (dir_ / "mine").lexically_normal().string());
+  EXPECT_EQ(read_case(p, {"output/directory=there"}).output.directory, "there");  // as typed
+  const auto d = write("d.prm", "subsection fem\n  set degree = 1\nend\n");
+  EXPECT_EQ(read_case(d).output.directory, "results/runs");  // the default: the working dir
+}
+
 }  // namespace
 }  // namespace msfem::cases

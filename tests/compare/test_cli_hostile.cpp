@@ -137,5 +137,17 @@ TEST(CliInterface, ThePrintedDefaultsRun) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+// A surface read in the wrong unit solves without error: msfem warns when it is not organ-sized.
+TEST(CliInterface, ASurfaceInTheWrongUnitIsWarnedAbout) {
+  TemporaryDirectory dir;
+  const auto r = run_msfem("run " + sphere + " --set 'geometry/source=" + cases_dir +
+                           "/data/pancreas_vh_female_m.obj' --set geometry/unit=mm --out " +
+                           (dir / "run").string());
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the surface spans 0.000"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("geometry/unit = mm"), std::string::npos) << r.err;
+  EXPECT_EQ(r.exit_code, 2) << r.err;  // and the 5 mm tool is then deeper than the model
+}
+
 }  // namespace
 }  // namespace msfem
