@@ -427,9 +427,18 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       for (auto& v : load.variants)
         v.force_depth.clear();
   }
-  if (run.variants.empty() && !run.failed_variants.empty())
-    throw std::runtime_error("every variant failed; the first, " + run.failed_variants[0].first +
-                             ": " + run.failed_variants[0].second);
+  if (run.variants.empty() && !run.failed_variants.empty()) {
+    std::string all;
+    for (const auto& [name, why] : run.failed_variants)
+      all += (all.empty() ? "" : "; ") + name + ": " + why;
+    // A time step no variant can take is the case's error (exit 2), named by its key.
+    if (parameters.timing.dt_s > 0 && settings.time_dynamics)
+      throw cases::InputError(parameters.file.string() + ": timing/dt = " +
+                              std::to_string(parameters.timing.dt_s) +
+                              " s: every variant failed with it (0 takes half each variant's "
+                              "stable step): " + all);
+    throw std::runtime_error("every variant failed: " + all);
+  }
   run.wall_time_s = seconds_since(start);
   return run;
 }

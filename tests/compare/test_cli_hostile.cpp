@@ -149,5 +149,20 @@ TEST(CliInterface, ASurfaceInTheWrongUnitIsWarnedAbout) {
   EXPECT_EQ(r.exit_code, 2) << r.err;  // and the 5 mm tool is then deeper than the model
 }
 
+// A time step no variant can take: known only once each variant is built (after the FEM), then
+// refused as the case's error, naming the key and every variant's failure, with no run folder.
+TEST(CliInterface, ATimeStepNoVariantCanTakeIsTheCasesError) {
+  TemporaryDirectory dir;
+  const auto r = run_msfem("run " + std::string(MSFEM_TEST_DATA_DIR) +
+                           "/small_sphere.prm --quiet --no-curve --no-cache --set timing/dt=1 "
+                           "--out " +
+                           (dir / "run").string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("small_sphere.prm: timing/dt = 1"), std::string::npos) << r.err;
+  for (const char* variant : {"three_tier:", "single_layer:", "tet_edges:", "skeleton:"})
+    EXPECT_NE(r.err.find(variant), std::string::npos) << variant;
+  EXPECT_FALSE(std::filesystem::exists(dir / "run"));
+}
+
 }  // namespace
 }  // namespace msfem
