@@ -88,6 +88,13 @@ const Hostile hostile[] = {
      "mass spring/skeleton/control points = 5000"},
     {"FixedRegionCatchingNoNode", "run " + sphere + " --set 'support/inner core scale=50'",
      "support/fixed region: it catches no node"},
+    // Under gravity alone, a fixed ball that holds no mesh node: the FEM would be singular (an
+    // iterative solver's fallback once returned 44 mm on a 50 mm sphere for such a case).
+    {"SingularFemFromATinyFixedRegion",
+     "run " + sphere +
+         " --set loads/tool/enabled=false --set 'loads/gravity=0,0,-9.81' --set 'support/fixed "
+         "region=sphere' --set 'support/sphere radius=1e-4'",
+     "support/fixed region"},
     {"UnknownIntegrator", "run " + sphere + " --set 'timing/integrator=verlet'", "verlet"},
     {"ErrorEstimateDegreeAtP2", "run " + sphere + " --set 'fem/error estimate=degree'",
      "fem/error estimate = degree needs fem/degree = 1"},
