@@ -6,6 +6,7 @@
 
 #include "msfem/compare/atomic_file.hpp"
 #include "msfem/compare/calibration_case.hpp"
+#include "msfem/compare/json_values.hpp"
 #include "msfem/compare/plots.hpp"
 #include "msfem/compare/run_outputs.hpp"
 
@@ -24,10 +25,6 @@ nlohmann::json errors_json(const std::vector<LoadErrors>& errors) {
   return list;
 }
 
-nlohmann::json optional_number(const std::optional<double>& x) {
-  return x ? nlohmann::json(*x) : nlohmann::json();
-}
-
 // The reference's own error at every load (null where fem/error estimate left it out).
 nlohmann::json estimates_json(const CaseCalibration& c) {
   nlohmann::json out = nlohmann::json::object();
@@ -36,8 +33,8 @@ nlohmann::json estimates_json(const CaseCalibration& c) {
     nlohmann::json list = nlohmann::json::array();
     for (const LoadReference& r : *references)
       list.push_back({{"load", r.load.label()},
-                      {"estimated_rel_l2_error", optional_number(r.fem_error.rel_l2_error)},
-                      {"estimated_force_rel_error", optional_number(r.fem_error.force_rel_error)}});
+                      {"estimated_rel_l2_error", json_or_null(r.fem_error.rel_l2_error)},
+                      {"estimated_force_rel_error", json_or_null(r.fem_error.force_rel_error)}});
     out[side] = list;
   }
   return out;

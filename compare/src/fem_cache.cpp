@@ -7,6 +7,7 @@
 
 #include "msfem/compare/atomic_file.hpp"
 #include "msfem/compare/content_hash.hpp"
+#include "msfem/compare/json_values.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -34,9 +35,6 @@ Eigen::Vector3d vec_from(const nlohmann::json& j) {
   return Eigen::Vector3d(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>());
 }
 
-nlohmann::json optional_number(const std::optional<double>& x) {
-  return x ? nlohmann::json(*x) : nlohmann::json();
-}
 std::optional<double> optional_from(const nlohmann::json& j) {
   return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
 }
@@ -44,7 +42,7 @@ std::optional<double> optional_from(const nlohmann::json& j) {
 nlohmann::json estimate_json(const FemErrorEstimate& e) {
   nlohmann::json loads = nlohmann::json::array();
   for (const auto& l : e.loads)
-    loads.push_back({optional_number(l.rel_l2_error), optional_number(l.force_rel_error)});
+    loads.push_back({json_or_null(l.rel_l2_error), json_or_null(l.force_rel_error)});
   return {{"method", e.method},
           {"note", e.note},
           {"dofs", e.dofs},

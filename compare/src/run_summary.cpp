@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "msfem/compare/json_values.hpp"
 #include "msfem/compare/run_outputs.hpp"
 
 namespace msfem::compare {
@@ -16,11 +17,6 @@ namespace {
 
 nlohmann::json vec(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
-}
-
-template <class T>
-nlohmann::json optional_json(const std::optional<T>& value) {
-  return value ? nlohmann::json(*value) : nlohmann::json();
 }
 
 nlohmann::json optional_vec(const std::optional<Eigen::Vector3d>& v) {
@@ -32,8 +28,8 @@ nlohmann::json optional_vec(const std::optional<Eigen::Vector3d>& v) {
 nlohmann::json estimate_at(const CaseRun& run, std::size_t load) {
   LoadErrorEstimate e;
   if (load < run.fem_error.loads.size()) e = run.fem_error.loads[load];
-  return {{"estimated_rel_l2_error", optional_json(e.rel_l2_error)},
-          {"estimated_force_rel_error", optional_json(e.force_rel_error)}};
+  return {{"estimated_rel_l2_error", json_or_null(e.rel_l2_error)},
+          {"estimated_force_rel_error", json_or_null(e.force_rel_error)}};
 }
 
 nlohmann::json zone(const ErrorMetrics& m) {
@@ -46,7 +42,7 @@ nlohmann::json curve_json(const std::vector<ForceDepthPoint>& curve) {
   for (const auto& pt : curve)
     points.push_back({{"depth_m", pt.depth_m},
                       {"force_N", vec(pt.force_n)},
-                      {"inverted_elements", optional_json(pt.inverted_elements)}});
+                      {"inverted_elements", json_or_null(pt.inverted_elements)}});
   return points;
 }
 
@@ -63,8 +59,8 @@ nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o)
           {"reaction_force_N", vec(o.tool_force)},
           {"reaction_force_rel_error", o.reaction_force_rel_error},
           {"volume_change", o.volume_change},
-          {"inverted_elements", optional_json(o.inverted_elements)},
-          {"force_depth_monotone", optional_json(o.force_depth_monotone)},
+          {"inverted_elements", json_or_null(o.inverted_elements)},
+          {"force_depth_monotone", json_or_null(o.force_depth_monotone)},
           {"force_depth", curve_json(o.force_depth)}};
 }
 
@@ -135,7 +131,7 @@ nlohmann::json summary_json(const CaseRun& run) {
       {"mpi_ranks", st.mpi_ranks},
       {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(run.fem.tool_force)},
       {"volume_change", run.fem.volume_change},
-      {"worst_cell_quality", optional_json(run.worst_cell_quality)},
+      {"worst_cell_quality", json_or_null(run.worst_cell_quality)},
       {"cache_key", run.fem_cache_key},
       {"from_cache", run.fem_from_cache},
       {"error_estimate",
@@ -152,7 +148,7 @@ nlohmann::json summary_json(const CaseRun& run) {
   for (const auto& pt : run.fem_force_depth)
     curve.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
   fem["force_depth"] = curve;
-  fem["force_depth_monotone"] = optional_json(run.fem_force_depth_monotone);
+  fem["force_depth_monotone"] = json_or_null(run.fem_force_depth_monotone);
 
   if (!run.other_tools.empty()) {
     nlohmann::json loads = nlohmann::json::array();
@@ -190,7 +186,7 @@ nlohmann::json summary_json(const CaseRun& run) {
                                           : nlohmann::json(v.reaction_force_rel_error)},
          {"volume_change", v.volume_change},
          {"patch_mean_displacement_m", optional_vec(v.patch_mean_displacement)},
-         {"patch_displacement_rel_error", optional_json(v.patch_displacement_rel_error)},
+         {"patch_displacement_rel_error", json_or_null(v.patch_displacement_rel_error)},
          {"not_resolved_by_reference", unresolved_metrics(run, v)},
          {"integrator", v.timing.integrator},
          {"dt_s", v.timing.dt_s},
@@ -203,8 +199,8 @@ nlohmann::json summary_json(const CaseRun& run) {
          {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
          {"newton_iterations", v.newton_iterations},
          {"force_depth", fd},
-         {"force_depth_monotone", optional_json(v.force_depth_monotone)},
-         {"inverted_elements", optional_json(v.inverted_elements)},
+         {"force_depth_monotone", json_or_null(v.force_depth_monotone)},
+         {"inverted_elements", json_or_null(v.inverted_elements)},
          {"warnings", v.warnings},
          {"parameters", v.parameters}});
     if (!run.other_tools.empty()) variants.back()["loads"] = variant_loads(run, v);

@@ -9,6 +9,7 @@
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/compare/case_run.hpp"
+#include "msfem/compare/json_values.hpp"
 #include "msfem/compare/run_outputs.hpp"
 
 namespace msfem::compare {
@@ -118,12 +119,6 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   return result;
 }
 
-namespace {
-nlohmann::json optional_number(const std::optional<double>& x) {
-  return x ? nlohmann::json(*x) : nlohmann::json();
-}
-}  // namespace
-
 nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& p : result.points)
@@ -140,8 +135,8 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
          {"steps_per_second", p.steps_per_second},
          {"realtime_factor", p.realtime_factor},
          {"ms_per_60hz_frame", p.ms_per_60hz_frame},
-         {"fem_estimated_rel_l2_error", optional_number(p.fem_estimated_rel_l2_error)},
-         {"fem_estimated_force_rel_error", optional_number(p.fem_estimated_force_rel_error)},
+         {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
+         {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
          {"not_resolved_by_reference", p.not_resolved_by_reference}});
   nlohmann::json failed = nlohmann::json::array();
   for (const auto& [resolution, why] : result.failed_resolutions)
