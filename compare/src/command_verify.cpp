@@ -23,6 +23,17 @@ nlohmann::json to_json(const fem_reference::VerificationReport& report, double s
                         {"rel_l2_error", l.rel_l2_error},
                         {"iterations", l.iterations},
                         {"solve_time_s", l.solve_time_s}});
+    nlohmann::json contact = nlohmann::json::array();
+    for (const auto& r : c.contact)
+      contact.push_back({{"depth_ratio", r.depth_ratio},
+                         {"force_n", r.force},
+                         {"hertz_force_n", r.hertz_force},
+                         {"sneddon_force_n", r.sneddon_force},
+                         {"contact_radius_m", r.contact_radius},
+                         {"sneddon_contact_radius_m", r.sneddon_contact_radius},
+                         {"active_nodes", r.active_nodes},
+                         {"active_set_iterations", r.iterations},
+                         {"max_penetration_m", r.max_penetration}});
     checks.push_back({{"name", c.name},
                       {"rel_l2_error", c.rel_l2_error},
                       {"observed_order",
@@ -32,7 +43,8 @@ nlohmann::json to_json(const fem_reference::VerificationReport& report, double s
                       {"tolerance", c.tolerance},
                       {"passed", c.passed},
                       {"note", c.note},
-                      {"levels", levels}});
+                      {"levels", levels},
+                      {"contact", contact}});
   }
   nlohmann::json locking = nlohmann::json::array();
   for (const auto& row : report.locking)

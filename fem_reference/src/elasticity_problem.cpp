@@ -49,6 +49,13 @@ void validate(const ElasticityModel& model) {
         "matrix is singular (rigid-body motion)");
   for (const Support& s : model.supports)
     if (!s.region) throw std::invalid_argument("support '" + s.name + "' has no region");
+  for (const SphereObstacle& o : model.obstacles)
+    if (!(o.radius > 0.0 && std::isfinite(o.radius)) || !o.center.allFinite() ||
+        !(o.push_direction.norm() > 0.0) || !o.push_direction.allFinite() ||
+        !(o.penalty_factor > 0.0 && std::isfinite(o.penalty_factor)) || o.max_iterations < 1)
+      throw std::invalid_argument("obstacle '" + o.name +
+                                  "' needs a finite positive radius, penalty factor and iteration "
+                                  "limit, a finite centre and a non-zero push direction");
   for (const Traction& t : model.tractions)
     if (!t.region || !t.traction)
       throw std::invalid_argument("traction '" + t.name + "' is incomplete");
@@ -317,6 +324,10 @@ double ElasticityProblem::equilibrium_defect() const {
     sum += r;
     scale = std::max(scale, r.norm());
   }
+  for (const ContactReport& c : impl_->contact_reports) {
+    sum += c.force;
+    scale = std::max(scale, c.force.norm());
+  }
   return scale > 0.0 ? sum.norm() / scale : 0.0;
 }
 
@@ -482,7 +493,9 @@ void ElasticityProblem::Implementation::solve() {
   }
   linear_system->apply_prescribed_values(rows, values);
   if (two_level()) linear_system->set_coarse_space(p1_coarse_space());
-  const detail::KrylovReport report = linear_system->solve(model.solver, coordinates);
+  const detail::KrylovReport report = model.obstacles.empty()
+                                          ? linear_system->solve(model.solver, coordinates)
+                                          : solve_with_contact(coordinates);
   solution = linear_system->gathered_solution();
   linear_system.reset();
   // Prescribed values exactly, not up to the solver's tolerance.
@@ -520,6 +533,10 @@ void ElasticityProblem::Implementation::compute_reactions() {
       reactions[std::size_t(s)][fe.system_to_component_index(i).first] += residual;
     }
   }
+  // K u - f at a prescribed DoF also holds the contact force on its node; the support's own
+  // reaction is the rest.
+  for (const auto& [dof, force] : contact_dof_force)
+    if (dof_support[dof] >= 0) reactions[std::size_t(dof_support[dof])][dof % dim] -= force;
   support_reactions.resize(reactions.size());
   for (std::size_t s = 0; s < reactions.size(); ++s)
     for (int c = 0; c < dim; ++c)

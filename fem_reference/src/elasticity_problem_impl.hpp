@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "msfem/fem_reference/elasticity_problem.hpp"
@@ -19,6 +20,7 @@
 namespace msfem::fem_reference::detail {
 class PetscLinearSystem;
 struct CoarseSpace;
+struct KrylovReport;
 }  // namespace msfem::fem_reference::detail
 
 namespace msfem::fem_reference {
@@ -41,6 +43,8 @@ struct ElasticityProblem::Implementation {
   void assemble_system();
   void solve();
   void compute_reactions();
+  /// The obstacles' active-set iteration around the linear solve (sphere_contact.cpp).
+  detail::KrylovReport solve_with_contact(const std::vector<double>& owned_node_coordinates);
 
   void locate_dof_support_points();
   void collect_prescribed_dofs();
@@ -72,6 +76,10 @@ struct ElasticityProblem::Implementation {
 
   std::vector<double> solution;  ///< all DoFs, gathered on every rank
   std::vector<Eigen::Vector3d> support_reactions;
+  std::vector<ContactReport> contact_reports;  ///< per model.obstacles entry
+  /// This rank's contact force per owned DoF (DoF, N), for the reactions of supports that share
+  /// a node with the contact (symmetry planes).
+  std::vector<std::pair<std::size_t, double>> contact_dof_force;
   Eigen::Vector3d applied_load = Eigen::Vector3d::Zero();
   SolveStatistics statistics;
   bool solved = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 
 #include "msfem/fem_reference/errors.hpp"
@@ -281,6 +282,9 @@ PetscLinearSystem::PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows
 }
 
 PetscLinearSystem::~PetscLinearSystem() {
+  kept_.reset();
+  VecDestroy(&base_rhs_);
+  MatDestroy(&base_matrix_);
   VecDestroy(&solution_);
   VecDestroy(&rhs_);
   MatDestroy(&matrix_);
@@ -341,16 +345,62 @@ void PetscLinearSystem::apply_prescribed_values(const std::vector<PetscInt>& row
                                  solution_, rhs_));
 }
 
-KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
-                                      const std::vector<double>& owned_node_coordinates) {
+void PetscLinearSystem::keep_base_system() {
+  MatDestroy(&base_matrix_);
+  VecDestroy(&base_rhs_);
+  MSFEM_PETSC(MatDuplicate(matrix_, MAT_COPY_VALUES, &base_matrix_));
+  MSFEM_PETSC(VecDuplicate(rhs_, &base_rhs_));
+  MSFEM_PETSC(VecCopy(rhs_, base_rhs_));
+}
+
+std::vector<double> PetscLinearSystem::owned_diagonal() const {
+  Vec diagonal = nullptr;
+  MSFEM_PETSC(MatCreateVecs(base_matrix_ ? base_matrix_ : matrix_, &diagonal, nullptr));
+  MSFEM_PETSC(MatGetDiagonal(base_matrix_ ? base_matrix_ : matrix_, diagonal));
+  const double* values = nullptr;
+  MSFEM_PETSC(VecGetArrayRead(diagonal, &values));
+  std::vector<double> result(values, values + owned_rows_);
+  MSFEM_PETSC(VecRestoreArrayRead(diagonal, &values));
+  VecDestroy(&diagonal);
+  return result;
+}
+
+void PetscLinearSystem::set_node_terms(const std::vector<PetscInt>& node_rows,
+                                       const std::vector<std::array<double, 9>>& blocks,
+                                       const std::vector<std::array<double, 3>>& rhs) {
+  if (!base_matrix_) throw FemError("set_node_terms before keep_base_system");
+  MSFEM_PETSC(MatCopy(base_matrix_, matrix_, SAME_NONZERO_PATTERN));
+  MSFEM_PETSC(VecCopy(base_rhs_, rhs_));
+  for (std::size_t k = 0; k < node_rows.size(); ++k) {
+    const std::array<PetscInt, 3> rows{{node_rows[k], node_rows[k] + 1, node_rows[k] + 2}};
+    MSFEM_PETSC(MatSetValues(matrix_, 3, rows.data(), 3, rows.data(), blocks[k].data(), ADD_VALUES));
+    MSFEM_PETSC(VecSetValues(rhs_, 3, rows.data(), rhs[k].data(), ADD_VALUES));
+  }
+  finish_assembly();
+}
+
+/// A configured KSP with what its preconditioner refers to; kept between the solves of a sequence
+/// (keep_base_system) so that the preconditioner is set up once.
+struct PetscLinearSystem::KrylovState {
   KSP ksp = nullptr;
+  MatNullSpace rigid_body_modes = nullptr;
+  Vec coordinates = nullptr;
+  TwoLevel two_level;
+  ~KrylovState() {
+    KSPDestroy(&ksp);
+    MatNullSpaceDestroy(&rigid_body_modes);
+    VecDestroy(&coordinates);
+  }
+};
+
+std::unique_ptr<PetscLinearSystem::KrylovState> PetscLinearSystem::configure(
+    const SolverSettings& settings, const std::vector<double>& owned_node_coordinates) {
+  auto state = std::make_unique<KrylovState>();
+  KSP& ksp = state->ksp;
   MSFEM_PETSC(KSPCreate(communicator_, &ksp));
   MSFEM_PETSC(KSPSetOperators(ksp, matrix_, matrix_));
   PC pc = nullptr;
   MSFEM_PETSC(KSPGetPC(ksp, &pc));
-  MatNullSpace rigid_body_modes = nullptr;
-  Vec coordinates = nullptr;
-  TwoLevel two_level;
   if (settings.preconditioner == Preconditioner::mumps) {
     MSFEM_PETSC(KSPSetType(ksp, KSPPREONLY));
     MSFEM_PETSC(PCSetType(pc, PCLU));
@@ -359,13 +409,13 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
     MSFEM_PETSC(KSPSetType(ksp, KSPCG));
     MSFEM_PETSC(
         KSPSetTolerances(ksp, settings.relative_tolerance, 1e-300, 1e10, settings.max_iterations));
-    set_rigid_body_modes(communicator_, matrix_, owned_node_coordinates, coordinates,
-                         rigid_body_modes);
+    set_rigid_body_modes(communicator_, matrix_, owned_node_coordinates, state->coordinates,
+                         state->rigid_body_modes);
     if (settings.preconditioner == Preconditioner::gamg) {
       if (coarse_space_.row_begin.empty())
         MSFEM_PETSC(PCSetType(pc, PCGAMG));
       else
-        two_level_preconditioner(communicator_, matrix_, coarse_space_, pc, two_level);
+        two_level_preconditioner(communicator_, matrix_, coarse_space_, pc, state->two_level);
     } else {
       MSFEM_PETSC(PCSetType(pc, PCHYPRE));
       MSFEM_PETSC(PCHYPRESetType(pc, "boomeramg"));
@@ -376,18 +426,31 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
   }
   MSFEM_PETSC(KSPSetFromOptions(ksp));
   if (settings.preconditioner == Preconditioner::gamg) finest_smoother_point_block_jacobi(ksp, pc);
-  const PetscErrorCode solve_code = KSPSolve(ksp, rhs_, solution_);
+  return state;
+}
+
+KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
+                                      const std::vector<double>& owned_node_coordinates) {
+  std::unique_ptr<KrylovState> state;
+  if (kept_) {
+    // The matrix changed by a few nodal blocks since the preconditioner was built: it still
+    // preconditions well, and its set-up costs more than the extra iterations.
+    MSFEM_PETSC(KSPSetOperators(kept_->ksp, matrix_, matrix_));
+    MSFEM_PETSC(KSPSetReusePreconditioner(kept_->ksp, PETSC_TRUE));
+  } else {
+    state = configure(settings, owned_node_coordinates);
+  }
+  KrylovState& s = kept_ ? *kept_ : *state;
+  const PetscErrorCode solve_code = KSPSolve(s.ksp, rhs_, solution_);
   KSPConvergedReason reason;
-  KSPGetConvergedReason(ksp, &reason);
+  KSPGetConvergedReason(s.ksp, &reason);
   PetscInt iterations = 0;
-  KSPGetIterationNumber(ksp, &iterations);
+  KSPGetIterationNumber(s.ksp, &iterations);
   PetscReal residual = 0.0;
-  KSPGetResidualNorm(ksp, &residual);
-  KSPDestroy(&ksp);
-  MatNullSpaceDestroy(&rigid_body_modes);
-  VecDestroy(&coordinates);
+  KSPGetResidualNorm(s.ksp, &residual);
   const std::string method = std::string(method_name(settings.preconditioner)) +
-                             (two_level.interpolation ? " (P2 over a P1 level)" : "");
+                             (s.two_level.interpolation ? " (P2 over a P1 level)" : "");
+  if (base_matrix_ && !kept_) kept_ = std::move(state);
   if (solve_code != 0)  // PETSc has printed its own trace; name the failing stage here
     throw SolverError(method + " failed: PETSc error " + std::to_string(int(solve_code)) +
                       " in KSPSolve after " + std::to_string(iterations) + " iterations" +

@@ -3,6 +3,8 @@
 #include <mpi.h>
 #include <petscksp.h>
 
+#include <array>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -62,11 +64,26 @@ class PetscLinearSystem {
   void apply_prescribed_values(const std::vector<PetscInt>& rows,
                                const std::vector<double>& values);
 
+  /// Keeps the present (eliminated) matrix and right-hand side as the base that set_node_terms adds
+  /// to: a sequence of solves that differ by per-node terms (contact penalties).
+  void keep_base_system();
+
+  /// The base matrix's diagonal on the owned rows.
+  std::vector<double> owned_diagonal() const;
+
+  /// matrix = base + a 3x3 block (row-major) on each listed node's diagonal, rhs = base rhs + a
+  /// 3-vector there. `node_rows` are the nodes' first (x) rows, owned by this rank; rows and columns
+  /// of prescribed components must be zero in the blocks. The solution is kept as the next start.
+  void set_node_terms(const std::vector<PetscInt>& node_rows,
+                      const std::vector<std::array<double, 9>>& blocks,
+                      const std::vector<std::array<double, 3>>& rhs);
+
   /// With a coarse space, CG + GAMG becomes CG + a two-level V-cycle: Chebyshev with point-block
   /// Jacobi on this matrix, one GAMG V-cycle on the Galerkin product P^T K P as the coarse solve.
   void set_coarse_space(CoarseSpace space) { coarse_space_ = std::move(space); }
 
-  /// Solves with the chosen method; `owned_node_coordinates` holds x, y, z of the node of each
+  /// Solves with the chosen method (after keep_base_system, every solve reuses the first one's
+  /// preconditioner); `owned_node_coordinates` holds x, y, z of the node of each
   /// owned DoF triple (for the rigid-body modes). Throws SolverError when not converged.
   KrylovReport solve(const SolverSettings& settings,
                      const std::vector<double>& owned_node_coordinates);
@@ -75,11 +92,18 @@ class PetscLinearSystem {
   std::vector<double> gathered_solution() const;
 
  private:
+  struct KrylovState;
+  std::unique_ptr<KrylovState> configure(const SolverSettings& settings,
+                                         const std::vector<double>& owned_node_coordinates);
+
   MPI_Comm communicator_;
   PetscInt first_owned_row_, owned_rows_;
   Mat matrix_ = nullptr;
   CoarseSpace coarse_space_;
   Vec rhs_ = nullptr, solution_ = nullptr;
+  Mat base_matrix_ = nullptr;
+  Vec base_rhs_ = nullptr;
+  std::unique_ptr<KrylovState> kept_;
   // Scratch of add_cell.
   std::vector<std::size_t> order_;
   std::vector<PetscInt> sorted_dofs_;

@@ -3,6 +3,7 @@
 #include <gmsh.h>
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -57,6 +58,36 @@ VolumeMesh mesh_box(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper, 
   detail::GmshSession session;
   gmsh::model::occ::addBox(lower.x(), lower.y(), lower.z(), extent.x(), extent.y(), extent.z());
   return mesh_occ_model(cell_size);
+}
+
+VolumeMesh mesh_graded_box(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
+                           const Eigen::Vector3d& focus, double min_cell_size, double growth,
+                           double max_cell_size) {
+  require_positive(min_cell_size, "smallest cell size");
+  require_positive(growth, "cell size growth");
+  if (!(max_cell_size >= min_cell_size))
+    throw std::invalid_argument("largest cell size must be at least the smallest");
+  const Eigen::Vector3d extent = upper - lower;
+  if (!(extent.minCoeff() > 0.0))
+    throw std::invalid_argument("box upper corner must exceed the lower");
+  detail::GmshSession session;
+  gmsh::model::occ::addBox(lower.x(), lower.y(), lower.z(), extent.x(), extent.y(), extent.z());
+  gmsh::model::occ::synchronize();
+  const int field = gmsh::model::mesh::field::add("MathEval");
+  char expression[256];
+  std::snprintf(expression, sizeof expression,
+                "Min(%.17g, %.17g + %.17g * Sqrt((x - %.17g)^2 + (y - %.17g)^2 + (z - %.17g)^2))",
+                max_cell_size, min_cell_size, growth, focus.x(), focus.y(), focus.z());
+  gmsh::model::mesh::field::setString(field, "F", expression);
+  gmsh::model::mesh::field::setAsBackgroundMesh(field);
+  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.Algorithm3D", 1);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", max_cell_size);
+  gmsh::option::setNumber("Mesh.MeshSizeMin", min_cell_size);
+  gmsh::option::setNumber("Mesh.Optimize", 1);
+  return detail::generate_tetrahedra(0);
 }
 
 VolumeMesh mesh_ball(const Eigen::Vector3d& center, double radius, double cell_size) {

@@ -9,13 +9,11 @@
 #include "msfem/fem_reference/elasticity_problem.hpp"
 #include "msfem/fem_reference/shape_mesher.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
+#include "verification_detail.hpp"
 
 namespace msfem::fem_reference {
 
-namespace {
-
-constexpr double lame_inner_radius = 0.5, lame_outer_radius = 1.0, lame_pressure = 1e3;
-constexpr double youngs_modulus = 1e5;  // Pa; the checks are linear, the value only scales u
+namespace detail {
 
 RefinementLevel level_of(const ElasticityProblem& problem, const VolumeMesh& mesh, double error) {
   const SolveStatistics s = problem.statistics();
@@ -36,6 +34,16 @@ double observed_order(const std::vector<RefinementLevel>& levels) {
   return std::log(coarse.rel_l2_error / fine.rel_l2_error) /
          std::log(coarse.cell_size / fine.cell_size);
 }
+
+}  // namespace detail
+
+using detail::level_of;
+using detail::observed_order;
+
+namespace {
+
+constexpr double lame_inner_radius = 0.5, lame_outer_radius = 1.0, lame_pressure = 1e3;
+constexpr double youngs_modulus = 1e5;  // Pa; the checks are linear, the value only scales u
 
 /// Displacement error of the Lame octant (see check_lame) on one mesh.
 RefinementLevel solve_lame(const VolumeMesh& mesh, unsigned int degree, double poisson_ratio) {
@@ -185,6 +193,12 @@ VerificationReport run_verification(const VerificationSettings& settings) {
     for (unsigned int degree : {1u, 2u})
       report.checks.push_back(check_lame(degree, nu, settings.lame_cell_sizes));
   report.checks.push_back(check_cantilever(settings.cantilever_cell_size));
+  for (unsigned int degree : {1u, 2u})
+    report.checks.push_back(check_hertz_contact(degree, settings.contact_depth_ratios,
+                                                degree == 1 ? settings.contact_cells_per_radius_p1
+                                                            : settings.contact_cells_per_radius_p2));
+  report.checks.push_back(
+      check_hertz_bonded(settings.contact_depth_ratios, settings.contact_cells_per_radius_p2.back()));
   if (settings.locking_table)
     report.locking = locking_table(settings.lame_cell_sizes[settings.lame_cell_sizes.size() / 2],
                                    {0.3, 0.45, 0.49, 0.499});

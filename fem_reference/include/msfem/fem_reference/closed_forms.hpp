@@ -53,4 +53,50 @@ inline double timoshenko_tip_deflection(double load, double length, double heigh
   return load * std::pow(length, 3) / (3 * youngs_modulus * I) + load * length / (kappa * G * A);
 }
 
+/// A rigid frictionless sphere of radius R pressed d into a linear elastic half-space, with the
+/// plane-strain modulus E* = E / (1 - nu^2).
+///  - Hertz (the sphere as a paraboloid, small d/R): a = sqrt(R d), F = 4/3 E* sqrt(R) d^(3/2).
+///  - Sneddon (1965, the exact sphere profile): d = a/2 ln((R + a)/(R - a)),
+///    F = E*/2 [(a^2 + R^2) ln((R + a)/(R - a)) - 2 a R]; it tends to Hertz as d/R -> 0.
+struct SphereOnHalfSpace {
+  double radius, youngs_modulus, poisson_ratio;
+
+  double reduced_modulus() const { return youngs_modulus / (1 - poisson_ratio * poisson_ratio); }
+  double hertz_contact_radius(double depth) const { return std::sqrt(radius * depth); }
+  double hertz_force(double depth) const {
+    return 4.0 / 3.0 * reduced_modulus() * std::sqrt(radius) * std::pow(depth, 1.5);
+  }
+  static double log_ratio(double a, double R) { return std::log((R + a) / (R - a)); }
+  /// a with a/2 ln((R + a)/(R - a)) = d, by bisection (the left side grows with a on (0, R)).
+  double sneddon_contact_radius(double depth) const {
+    double low = 0.0, high = radius * (1 - 1e-15);
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (low + high);
+      (0.5 * mid * log_ratio(mid, radius) < depth ? low : high) = mid;
+    }
+    return 0.5 * (low + high);
+  }
+  double sneddon_force(double depth) const {
+    const double a = sneddon_contact_radius(depth), R = radius;
+    return 0.5 * reduced_modulus() * ((a * a + R * R) * log_ratio(a, R) - 2 * a * R);
+  }
+};
+
+/// Boussinesq's point force P on the surface z = 0 of the half-space z <= 0, pushing in -z, at
+/// the origin (Johnson, Contact Mechanics, eq. 3.20 with depth s = -z):
+///   u_s = P/(4 pi G) [s^2/rho^3 + 2 (1 - nu)/rho],  u_r = P/(4 pi G) [r s/rho^3 - (1 - 2 nu)/(rho + s)]
+/// (u_s into the body, u_r away from the axis). Far from a contact of total force P it is the
+/// contact's displacement, which is how a finite block stands in for the half-space.
+inline Eigen::Vector3d boussinesq_displacement(double force, double youngs_modulus,
+                                               double poisson_ratio, const Eigen::Vector3d& x) {
+  const double G = youngs_modulus / (2 * (1 + poisson_ratio)), s = -x.z();
+  const double r = std::hypot(x.x(), x.y()), rho = x.norm();
+  const double scale = force / (4 * M_PI * G);
+  const double u_s = scale * (s * s / (rho * rho * rho) + 2 * (1 - poisson_ratio) / rho);
+  const double u_r = scale * (r * s / (rho * rho * rho) - (1 - 2 * poisson_ratio) / (rho + s));
+  const Eigen::Vector3d radial =
+      r > 0.0 ? Eigen::Vector3d(x.x() / r, x.y() / r, 0.0) : Eigen::Vector3d::Zero();
+  return u_r * radial - u_s * Eigen::Vector3d::UnitZ();
+}
+
 }  // namespace msfem::fem_reference

@@ -49,6 +49,40 @@ struct Traction {
   TractionField traction;
 };
 
+/// A rigid sphere the body may touch without friction (Signorini conditions): a boundary node may
+/// not enter it, and it can only push. Solved by a semi-smooth Newton (primal-dual active set)
+/// iteration on a nodal penalty: a node is active when its current position lies inside the sphere;
+/// an active node gets the normal spring k n n^T towards the sphere's surface along the sphere's
+/// normal at the node's current position (tangential motion free), with k = penalty_factor times
+/// the node's diagonal stiffness; each iteration is one linear solve started from the previous
+/// solution; it stops when the active set repeats. The penetration left is the node's contact
+/// force over k, about (cell size / contact radius) / penalty_factor of the depth, and is reported.
+struct SphereObstacle {
+  std::string name;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  /// Direction the sphere is pushed into the body; the contact radius is measured about the axis
+  /// through `center` along it.
+  Eigen::Vector3d push_direction = -Eigen::Vector3d::UnitZ();
+  /// Boundary nodes that may touch it; unset: every boundary node.
+  Region candidates;
+  double penalty_factor = 1e4;
+  int max_iterations = 30;
+};
+
+/// The state of one SphereObstacle's contact after the solve.
+struct ContactReport {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< N, the sphere's force on the body
+  int active_nodes = 0;
+  int iterations = 0;  ///< active-set iterations, one linear solve each
+  /// m, sqrt(5/2 <r^2>_F): the contact forces' second moment about the axis. Exact for a Hertzian
+  /// pressure p0 sqrt(1 - r^2/a^2), and from consistent nodal forces (P2) exact for any pressure's
+  /// moment, so it does not jump by a cell when one more node touches.
+  double contact_radius = 0.0;
+  double outermost_node_radius = 0.0;  ///< m, the active node farthest from the axis
+  double max_penetration = 0.0;        ///< m, the deepest node inside the sphere
+};
+
 enum class Preconditioner {
   gamg,        ///< PETSc CG + GAMG with the six rigid-body modes as near-null space (default)
   boomer_amg,  ///< PETSc CG + hypre BoomerAMG
@@ -71,6 +105,7 @@ struct ElasticityModel {
   std::vector<Support> supports;
   std::vector<Traction> tractions;
   VectorField body_force;  ///< optional, N/m^3, added to density * gravity
+  std::vector<SphereObstacle> obstacles;
   SolverSettings solver;
 };
 
@@ -80,7 +115,7 @@ struct SolveStatistics {
   std::size_t vertices = 0;
   std::size_t prescribed_dofs = 0;
   int mpi_ranks = 1;
-  int iterations = 0;
+  int iterations = 0;  ///< Krylov iterations, summed over the contact's active-set iterations
   double residual_norm = 0.0;  ///< final (preconditioned) residual norm
   double setup_time_s = 0.0;
   double assemble_time_s = 0.0;
@@ -120,6 +155,9 @@ class ElasticityProblem {
   /// Force (N) that the named support exerts on the body: the residual K u - f summed over the
   /// support's prescribed DoFs, per component. The force the body exerts on a tool is its negative.
   Eigen::Vector3d reaction_force(const std::string& support_name) const;
+
+  /// The named obstacle's contact; throws std::invalid_argument for an unknown name.
+  ContactReport contact(const std::string& obstacle_name) const;
 
   /// Sum of all applied loads (body force and tractions), N. At equilibrium the reactions of all
   /// supports add up to minus this.

@@ -18,6 +18,12 @@ VolumeMesh mesh_hollow_sphere(double inner_radius, double outer_radius, double c
 /// The box [lower, upper].
 VolumeMesh mesh_box(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper, double cell_size);
 
+/// The box [lower, upper] with cells of size min_cell_size + growth * |x - focus|, at most
+/// max_cell_size: fine at a contact, coarse far from it.
+VolumeMesh mesh_graded_box(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
+                           const Eigen::Vector3d& focus, double min_cell_size, double growth,
+                           double max_cell_size);
+
 /// The ball |x - center| <= radius.
 VolumeMesh mesh_ball(const Eigen::Vector3d& center, double radius, double cell_size);
 
