@@ -125,9 +125,7 @@ VerificationCheck check_hertz_contact(unsigned int degree, const std::vector<dou
                                       const std::vector<double>& cells_per_radius) {
   VerificationCheck check;
   check.name = "hertz_contact_p" + std::to_string(degree);
-  // P1 tetrahedra lock at nu = 0.45: their force error falls at order 2, from 15 % at 5 cells per
-  // contact radius to 2.0-2.2 % at 20; within 2 % would take ~80 k DoFs per depth.
-  check.tolerance = degree == 1 ? 0.025 : 0.02;
+  check.tolerance = 0.02;
   const double largest = *std::max_element(depth_ratios.begin(), depth_ratios.end());
   for (double cells : cells_per_radius) {
     RefinementLevel level;

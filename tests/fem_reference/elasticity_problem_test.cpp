@@ -70,6 +70,58 @@ TEST(ElasticityProblem, ToolIndentationOfABallWithFixedCore) {
   }
 }
 
+TEST(ElasticityProblem, FrictionlessSphereContactOnABall) {
+  const testing::TestSurface surface = testing::icosphere(3, radius);
+  const VolumeMesh mesh = mesh_closed_surface(surface.vertices, surface.triangles);
+  ElasticityModel bonded = indentation_model(2, surface);
+  ElasticityModel contact = bonded;
+  contact.supports.pop_back();  // the tool as a prescribed patch
+  SphereObstacle sphere;
+  sphere.name = "tool";
+  sphere.radius = 0.01;
+  sphere.center = Eigen::Vector3d(0, 0, radius + 0.01 - 0.005);
+  sphere.push_direction = -Eigen::Vector3d::UnitZ();
+  contact.obstacles.push_back(sphere);
+  ElasticityProblem with_contact(mesh, contact), with_patch(mesh, bonded);
+  with_contact.run();
+  with_patch.run();
+  const ContactReport report = with_contact.contact("tool");
+  // Equilibrium with the contact force counted; the core carries what the sphere pushes.
+  EXPECT_LT(with_contact.equilibrium_defect(), 1e-6);
+  EXPECT_NEAR((report.force + with_contact.reaction_force("core")).norm(), 0.0,
+              1e-6 * report.force.norm());
+  // Pushes down, only pushes, and the adhesive patch pulls back: frictionless is stiffer.
+  EXPECT_LT(report.force.z(), 0.0);
+  EXPECT_GT(std::abs(report.force.z()), std::abs(with_patch.reaction_force("tool").z()));
+  EXPECT_GT(report.active_nodes, 3);
+  EXPECT_LE(report.iterations, 10);
+  EXPECT_GT(report.contact_radius, 0.0);
+  EXPECT_LE(report.contact_radius, std::sqrt(2 * 0.01 * 0.005) * 1.05);
+  // No surface vertex ends inside the sphere by more than the stated penetration.
+  const Eigen::MatrixX3d u = with_contact.vertex_displacements();
+  for (Eigen::Index i = 0; i < surface.vertices.rows(); ++i)
+    EXPECT_GE((surface.vertices.row(i) + u.row(i) - sphere.center.transpose()).norm(),
+              sphere.radius - report.max_penetration - 1e-15);
+  EXPECT_LT(report.max_penetration, 1e-4 * 0.005);
+  EXPECT_THROW(with_contact.contact("other"), std::invalid_argument);
+}
+
+TEST(ElasticityProblem, ObstacleWithoutCandidatesIsRefused) {
+  const testing::TestSurface surface = testing::icosphere(2, radius);
+  const VolumeMesh mesh = mesh_closed_surface(surface.vertices, surface.triangles);
+  ElasticityModel model = indentation_model(1, surface);
+  model.supports.pop_back();
+  SphereObstacle sphere;
+  sphere.name = "tool";
+  sphere.radius = 0.01;
+  sphere.candidates = [](const Eigen::Vector3d& x) { return x.z() > 1.0; };
+  model.obstacles.push_back(sphere);
+  ElasticityProblem problem(mesh, model);
+  EXPECT_THROW(problem.run(), std::invalid_argument);
+  model.obstacles[0].radius = -1.0;
+  EXPECT_THROW(ElasticityProblem(mesh, model), std::invalid_argument);
+}
+
 TEST(ElasticityProblem, GravityIsCarriedByTheSupport) {
   const testing::TestSurface surface = testing::icosphere(2, radius);
   const VolumeMesh mesh = mesh_closed_surface(surface.vertices, surface.triangles);

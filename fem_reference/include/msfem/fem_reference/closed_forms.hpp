@@ -84,7 +84,8 @@ struct SphereOnHalfSpace {
 
 /// Boussinesq's point force P on the surface z = 0 of the half-space z <= 0, pushing in -z, at
 /// the origin (Johnson, Contact Mechanics, eq. 3.20 with depth s = -z):
-///   u_s = P/(4 pi G) [s^2/rho^3 + 2 (1 - nu)/rho],  u_r = P/(4 pi G) [r s/rho^3 - (1 - 2 nu)/(rho + s)]
+///   u_s = P/(4 pi G) [s^2/rho^3 + 2 (1 - nu)/rho],
+///   u_r = P/(4 pi G) [r s/rho^3 - (1 - 2 nu) r/(rho (rho + s))]
 /// (u_s into the body, u_r away from the axis). Far from a contact of total force P it is the
 /// contact's displacement, which is how a finite block stands in for the half-space.
 inline Eigen::Vector3d boussinesq_displacement(double force, double youngs_modulus,
@@ -93,7 +94,8 @@ inline Eigen::Vector3d boussinesq_displacement(double force, double youngs_modul
   const double r = std::hypot(x.x(), x.y()), rho = x.norm();
   const double scale = force / (4 * M_PI * G);
   const double u_s = scale * (s * s / (rho * rho * rho) + 2 * (1 - poisson_ratio) / rho);
-  const double u_r = scale * (r * s / (rho * rho * rho) - (1 - 2 * poisson_ratio) / (rho + s));
+  const double u_r =
+      scale * (r * s / (rho * rho * rho) - (1 - 2 * poisson_ratio) * r / (rho * (rho + s)));
   const Eigen::Vector3d radial =
       r > 0.0 ? Eigen::Vector3d(x.x() / r, x.y() / r, 0.0) : Eigen::Vector3d::Zero();
   return u_r * radial - u_s * Eigen::Vector3d::UnitZ();
