@@ -151,11 +151,24 @@ Eigen::Vector3d MassSpringModel::constrained_target(int node) const {
   return (network_.rest_positions.row(node) + prescribed_displacement_.row(node)).transpose();
 }
 
-void MassSpringModel::set_contact(const SphereContactForceField& contact) {
-  if (contact.num_dofs() != num_dofs())
+namespace {
+
+void check_contact_size(const ToolContact& contact, int num_dofs) {
+  if (contact.num_dofs() != num_dofs)
     throw ModelError("contact: built for " + std::to_string(contact.num_dofs() / 3) +
-                     " nodes, model has " + std::to_string(num_nodes()));
-  contact_ = contact;
+                     " nodes, model has " + std::to_string(num_dofs / 3));
+}
+
+}  // namespace
+
+void MassSpringModel::set_contact(const SphereContactForceField& contact) {
+  check_contact_size(contact, num_dofs());
+  contact_ = std::make_shared<const SphereContactForceField>(contact);
+}
+
+void MassSpringModel::set_contact(const SurfaceContactForceField& contact) {
+  check_contact_size(contact, num_dofs());
+  contact_ = std::make_shared<const SurfaceContactForceField>(contact);
 }
 
 void MassSpringModel::set_volume(const VolumeForceField& volume) {

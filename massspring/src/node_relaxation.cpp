@@ -80,7 +80,7 @@ double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vecto
     k += net.anchor_stiffness[a] * identity;
   }
   if (in_contact_set_[i]) {
-    const SphereContactForceField& contact = *model_.contact();
+    const ToolContact& contact = *model_.contact();
     const Eigen::Vector3d w = p - contact.tool().center;
     const double rho = w.norm();
     const double gap = contact.tool().radius - rho;

@@ -2,31 +2,14 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <nanoflann.hpp>
 #include <string>
 
+#include "kd_tree.hpp"
 #include "msfem/massspring/errors.hpp"
 
 namespace msfem::massspring {
-namespace {
-
-// nanoflann dataset adaptor over the rows of an n x 3 matrix.
-struct PointCloud {
-  const Eigen::MatrixX3d& points;
-  std::size_t kdtree_get_point_count() const { return static_cast<std::size_t>(points.rows()); }
-  double kdtree_get_pt(std::size_t index, std::size_t dim) const {
-    return points(static_cast<Eigen::Index>(index), static_cast<Eigen::Index>(dim));
-  }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>,
-                                                   PointCloud, 3, std::size_t>;
-
-}  // namespace
+using detail::KdTree;
+using detail::PointCloud;
 
 void check_surface(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
                    const char* what) {

@@ -114,22 +114,25 @@ std::vector<int> prescribe_contact_patch(MassSpringModel& model, const ToolInden
   return patch;
 }
 
+double stiffest_surface_node(const MassSpringModel& model) {
+  const SpringNetwork& net = model.network();
+  Eigen::VectorXd summed = Eigen::VectorXd::Zero(net.num_nodes());
+  for (int s = 0; s < net.num_springs(); ++s) {
+    summed[net.springs(s, 0)] += net.stiffness[s];
+    summed[net.springs(s, 1)] += net.stiffness[s];
+  }
+  for (int a = 0; a < net.num_anchors(); ++a)
+    summed[net.anchor_node[a]] += net.anchor_stiffness[a];
+  double largest = 0.0;
+  for (int i : net.surface_nodes)
+    largest = std::max(largest, summed[i]);
+  return largest > 0.0 ? largest : 1.0;
+}
+
 double activate_sphere_contact(MassSpringModel& model, const ToolIndentation& indent,
                                double penalty_stiffness) {
   const SpringNetwork& net = model.network();
-  if (penalty_stiffness <= 0.0) {
-    Eigen::VectorXd summed = Eigen::VectorXd::Zero(net.num_nodes());
-    for (int s = 0; s < net.num_springs(); ++s) {
-      summed[net.springs(s, 0)] += net.stiffness[s];
-      summed[net.springs(s, 1)] += net.stiffness[s];
-    }
-    for (int a = 0; a < net.num_anchors(); ++a)
-      summed[net.anchor_node[a]] += net.anchor_stiffness[a];
-    double largest = 0.0;
-    for (int i : net.surface_nodes)
-      largest = std::max(largest, summed[i]);
-    penalty_stiffness = 1000.0 * (largest > 0.0 ? largest : 1.0);
-  }
+  if (penalty_stiffness <= 0.0) penalty_stiffness = 1000.0 * stiffest_surface_node(model);
   model.set_contact(SphereContactForceField(net.num_nodes(), net.surface_nodes, indent.tool(),
                                             penalty_stiffness));
   return penalty_stiffness;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -8,6 +9,7 @@
 #include "msfem/massspring/force_model.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 #include "msfem/massspring/spring_network.hpp"
+#include "msfem/massspring/surface_contact.hpp"
 #include "msfem/massspring/tool_contact.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 
@@ -54,10 +56,11 @@ class MassSpringModel : public ForceModel {
   /// Where a constrained node is held: rest position + prescribed displacement.
   Eigen::Vector3d constrained_target(int node) const;
 
-  // --- tool contact (penalty, frictionless) ---
+  // --- tool contact (penalty, frictionless): nodes only, or the surface's triangles ---
   void set_contact(const SphereContactForceField& contact);
+  void set_contact(const SurfaceContactForceField& contact);
   void clear_contact() { contact_.reset(); }
-  const std::optional<SphereContactForceField>& contact() const { return contact_; }
+  const ToolContact* contact() const { return contact_.get(); }
 
   // --- volume preservation (the bulk stiffness central springs lack) ---
   void set_volume(const VolumeForceField& volume);
@@ -107,7 +110,7 @@ class MassSpringModel : public ForceModel {
   Eigen::MatrixX3d external_force_;
   std::vector<char> constrained_;
   Eigen::MatrixX3d prescribed_displacement_;
-  std::optional<SphereContactForceField> contact_;
+  std::shared_ptr<const ToolContact> contact_;  ///< shared by copies: the tool is immutable
   std::optional<VolumeForceField> volume_;
 };
 

@@ -27,10 +27,28 @@ struct ToolIndentation {
   SphereTool tool() const;
 };
 
+/// A rigid tool's frictionless contact as a force field: what the model's contact slot holds, the
+/// static solver and the integrators see as one more ForceModel, and a haptic loop reads back.
+class ToolContact : public ForceModel {
+ public:
+  virtual const SphereTool& tool() const = 0;
+  /// The nodes the contact can push.
+  virtual const std::vector<int>& nodes() const = 0;
+  /// A node's contact stiffness (N/m) when the tool presses on it: the node penalty, or for a
+  /// surface contact the pressure penalty times a mean node's area. Preconditioners and the node
+  /// relaxation use it; the forces come from add_force.
+  virtual double penalty_stiffness() const = 0;
+
+  void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                        Eigen::VectorXd&) const override {}
+  void add_dfdv_triplets(const Eigen::VectorXd&, Triplets&) const override {}
+};
+
 /// Frictionless contact between a sphere and a set of nodes, regularised by a penalty: a node at
 /// distance ρ < r from the centre is pushed out with f = k_p (r - ρ) (x - c)/ρ, U = ½ k_p (r - ρ)².
-/// Penetration at equilibrium is |f_node| / k_p, so k_p is chosen stiff against the springs.
-class SphereContactForceField : public ForceModel {
+/// Penetration at equilibrium is |f_node| / k_p, so k_p is chosen stiff against the springs. A
+/// tool smaller than the surface's cells can slip between nodes: SurfaceContactForceField cannot.
+class SphereContactForceField : public ToolContact {
  public:
   SphereContactForceField(int num_nodes, std::vector<int> nodes, SphereTool tool,
                           double penalty_stiffness);
@@ -42,15 +60,12 @@ class SphereContactForceField : public ForceModel {
   void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                         const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                         Linearisation mode = Linearisation::exact) const override;
-  void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd&,
-                        Eigen::VectorXd&) const override {}
   void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
                          Linearisation mode = Linearisation::exact) const override;
-  void add_dfdv_triplets(const Eigen::VectorXd&, Triplets&) const override {}
 
-  const SphereTool& tool() const { return tool_; }
-  const std::vector<int>& nodes() const { return nodes_; }
-  double penalty_stiffness() const { return penalty_; }
+  const SphereTool& tool() const override { return tool_; }
+  const std::vector<int>& nodes() const override { return nodes_; }
+  double penalty_stiffness() const override { return penalty_; }
 
  private:
   Eigen::Matrix3d block(const Eigen::Vector3d& position, Linearisation mode) const;
@@ -71,6 +86,10 @@ std::vector<int> prescribe_contact_patch(MassSpringModel& model, const ToolInden
 double activate_sphere_contact(MassSpringModel& model, const ToolIndentation& indent,
                                double penalty_stiffness = 0.0);
 
+/// The largest summed stiffness (springs and anchors) at a surface node, N/m: what a contact
+/// penalty must dominate.
+double stiffest_surface_node(const MassSpringModel& model);
+
 /// Force the tissue exerts on the tool (what a haptic device renders), at state x (statics, v = 0):
 /// with a prescribed patch, the sum over the patch of the internal and applied forces, which at
 /// equilibrium balance the tool's push; with penalty contact, minus the sum of contact forces.
@@ -80,6 +99,7 @@ Eigen::Vector3d contact_reaction_force(const MassSpringModel& model, const Eigen
 
 /// For dynamics: moves contact nodes inside the tool onto its surface (closest point) and removes
 /// their velocity component towards the centre. Returns the number of nodes projected.
+/// With a surface contact only the nodes are projected (a triangle's interior may stay inside).
 int project_out_of_tool(const MassSpringModel& model, Eigen::VectorXd& x, Eigen::VectorXd& v);
 
 }  // namespace msfem::massspring

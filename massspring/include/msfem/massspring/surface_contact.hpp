@@ -1,0 +1,75 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "msfem/massspring/tool_contact.hpp"
+
+namespace msfem::massspring {
+
+class MassSpringModel;
+
+/// Frictionless contact of a rigid sphere with the surface's triangles, so that a tool smaller than
+/// the cells, or pressed between nodes, is still felt. A pressure penalty over the surface:
+///   U = ½ κ ∫_S max(0, r - |x(s) - c|)² dA_rest,
+/// pressure p = κ (r - ρ) along the sphere's normal at each point, the point's force shared among
+/// its triangle's nodes by barycentric weights. The integral is taken at the centroids of a
+/// uniform n x n subdivision of each triangle, with n from its rest edge (at most a sixth of the
+/// tool's radius per sub-edge), so the contact is resolved whatever the mesh. Energy, force and
+/// Jacobians are those of that quadrature exactly (checked by finite differences). The broad phase
+/// is a k-d tree over the rest triangles' centroids (nanoflann), queried per call with the tool's
+/// radius plus the largest triangle and the largest surface displacement.
+class SurfaceContactForceField : public ToolContact {
+ public:
+  /// `rest_positions` n x 3 (m), `triangles` in node ids; κ = `pressure_penalty` in Pa/m.
+  SurfaceContactForceField(const Eigen::MatrixX3d& rest_positions, Eigen::MatrixX3i triangles,
+                           SphereTool tool, double pressure_penalty);
+
+  int num_dofs() const override { return 3 * num_nodes_; }
+  void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                 Eigen::VectorXd& f) const override;
+  double potential_energy(const Eigen::VectorXd& x) const override;
+  void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                        const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                        Linearisation mode = Linearisation::exact) const override;
+  void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
+                         Linearisation mode = Linearisation::exact) const override;
+
+  const SphereTool& tool() const override { return tool_; }
+  const std::vector<int>& nodes() const override { return nodes_; }
+  double penalty_stiffness() const override { return pressure_penalty_ * mean_node_area_; }
+  double pressure_penalty() const { return pressure_penalty_; }
+
+  /// The contact area (m², rest measure) and the number of triangles touched at x.
+  double contact_area(const Eigen::VectorXd& x) const;
+
+  struct BroadPhase;  ///< the k-d tree (defined in the source)
+
+ private:
+  /// Calls `visit(triangle, b0, b1, b2, coefficient, w)` for every quadrature point inside the
+  /// sphere, coefficient = κ A weight, w = x(s) - c.
+  template <class Visit>
+  void for_each_contact_point(const Eigen::VectorXd& x, Visit&& visit) const;
+  Eigen::Matrix3d block(const Eigen::Vector3d& w, Linearisation mode) const;
+
+  int num_nodes_;
+  Eigen::MatrixX3d rest_positions_;
+  Eigen::MatrixX3i triangles_;
+  std::vector<double> rest_area_;
+  std::vector<int> subdivisions_;
+  std::vector<int> nodes_;
+  SphereTool tool_;
+  double pressure_penalty_;
+  double mean_node_area_ = 0.0;
+  double largest_triangle_radius_ = 0.0;
+  std::shared_ptr<const BroadPhase> broad_phase_;
+};
+
+/// Activates the surface contact of the tool at full depth with the model's surface triangles.
+/// pressure_penalty <= 0 picks 1000 x the stiffest surface node's summed stiffness over a mean
+/// surface node's area. Returns the pressure penalty used (Pa/m).
+double activate_surface_contact(MassSpringModel& model, const ToolIndentation& indent,
+                                double pressure_penalty = 0.0);
+
+}  // namespace msfem::massspring
