@@ -80,10 +80,13 @@ void declare_loads(ParameterHandler& prm) {
   prm.declare_entry("gravity", "0,0,0", point_pattern(), "Gravitational acceleration (m/s^2).");
   prm.enter_subsection("tool");
   prm.declare_entry("enabled", "true", Patterns::Bool(), "Press a rigid spherical tool.");
-  prm.declare_entry("mode", "prescribed", Patterns::Selection("prescribed|contact"),
-                    "prescribed: the contact patch moves with the tool. contact (frictionless "
-                    "contact) is reserved: msfem run, sweep and calibrate refuse it until the FEM "
-                    "reference can press a tool by contact.");
+  prm.declare_entry(
+      "mode", "bonded", Patterns::Selection("bonded|prescribed|contact"),
+      "contact: frictionless contact in both models (the FEM's surface nodes may not enter the "
+      "sphere and are pushed only; the springs' surface triangles feel its pressure), what a "
+      "haptic device renders. bonded (alias prescribed): every surface node inside the pushed "
+      "sphere is moved onto it and held, an adhesive patch that underestimates the force (0.5-0.7 "
+      "of Hertz on a half-space, msfem verify hertz_bonded_p2).");
   prm.declare_entry(
       "directions", "0,0,1", Patterns::List(point_pattern(), 1, Patterns::List::max_int_value, ";"),
       "Where the tool presses, one indentation per entry (';'-separated): the surface "

@@ -112,10 +112,10 @@ std::vector<ForceDepthPoint> fem_force_depth(const Problem& problem,
   const auto start = Clock::now();
   for (std::size_t i = 0; i < depths.size(); ++i) {
     // The run's own depth is already solved.
-    const Eigen::Vector3d force =
-        depths[i] == tool->depth ? at_depth_solution.tool_force
-                                 : solve_fem(problem, mesh, at_depth(*tool, depths[i])).tool_force;
-    curve.push_back({depths[i], force, std::nullopt});
+    const FemSolution s = depths[i] == tool->depth
+                              ? at_depth_solution
+                              : solve_fem(problem, mesh, at_depth(*tool, depths[i]));
+    curve.push_back({depths[i], s.tool_force, std::nullopt, s.contact});
     progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
                      static_cast<int>(depths.size()), seconds_since(start));
   }
@@ -363,6 +363,21 @@ std::vector<double> loading_path(std::vector<double> depths, double case_depth, 
   return path;
 }
 
+std::optional<double> force_depth_exponent(const std::vector<ForceDepthPoint>& curve,
+                                           const std::optional<ToolPlacement>& tool) {
+  if (!tool || curve.size() < 2) return std::nullopt;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (const ForceDepthPoint& p : curve) {
+    const double push = p.force_n.dot(tool->outward_normal);
+    if (!(push > 0.0) || !(p.depth_m > 0.0)) return std::nullopt;
+    const double x = std::log(p.depth_m), y = std::log(push);
+    n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double spread = n * sxx - sx * sx;
+  if (!(spread > 0.0)) return std::nullopt;
+  return (n * sxy - sx * sy) / spread;
+}
+
 std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,
                                            const std::optional<ToolPlacement>& tool) {
   if (!tool || curve.size() < 2) return std::nullopt;
@@ -433,10 +448,11 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       all += (all.empty() ? "" : "; ") + name + ": " + why;
     // A time step no variant can take is the case's error (exit 2), named by its key.
     if (parameters.timing.dt_s > 0 && settings.time_dynamics)
-      throw cases::InputError(parameters.file.string() + ": timing/dt = " +
-                              std::to_string(parameters.timing.dt_s) +
+      throw cases::InputError(parameters.file.string() +
+                              ": timing/dt = " + std::to_string(parameters.timing.dt_s) +
                               " s: every variant failed with it (0 takes half each variant's "
-                              "stable step): " + all);
+                              "stable step): " +
+                              all);
     throw std::runtime_error("every variant failed: " + all);
   }
   run.wall_time_s = seconds_since(start);

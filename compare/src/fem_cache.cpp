@@ -61,6 +61,29 @@ FemErrorEstimate estimate_from(const nlohmann::json& j) {
   return e;
 }
 
+nlohmann::json contact_json(const std::optional<fem_reference::ContactReport>& c) {
+  if (!c) return nullptr;
+  return {{"force", vec(c->force)},
+          {"active_nodes", c->active_nodes},
+          {"iterations", c->iterations},
+          {"contact_radius", c->contact_radius},
+          {"outermost_node_radius", c->outermost_node_radius},
+          {"max_penetration", c->max_penetration}};
+}
+
+std::optional<fem_reference::ContactReport> contact_from(const nlohmann::json& j, const char* key) {
+  if (!j.contains(key) || j.at(key).is_null()) return std::nullopt;
+  const nlohmann::json& c = j.at(key);
+  fem_reference::ContactReport r;
+  r.force = vec_from(c.at("force"));
+  r.active_nodes = c.at("active_nodes");
+  r.iterations = c.at("iterations");
+  r.contact_radius = c.at("contact_radius");
+  r.outermost_node_radius = c.at("outermost_node_radius");
+  r.max_penetration = c.at("max_penetration");
+  return r;
+}
+
 }  // namespace
 
 std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths,
@@ -85,6 +108,7 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
     h.matrix(t.outward_normal);
     h.number(t.radius);
     h.number(t.depth);
+    if (t.frictionless) h.text("contact");  // the bonded patch's keys stay what they were
   }
   const auto& patch = p.loads.patch_force;
   h.number(patch.enabled);
@@ -135,8 +159,10 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     s.statistics.setup_time_s = st.at("setup_time_s");
     s.statistics.assemble_time_s = st.at("assemble_time_s");
     s.statistics.solve_time_s = st.at("solve_time_s");
+    s.contact = contact_from(j, "contact");
     for (const auto& p : j.at("force_depth"))
-      e.force_depth.push_back({p.at("depth_m"), vec_from(p.at("force_N")), std::nullopt});
+      e.force_depth.push_back(
+          {p.at("depth_m"), vec_from(p.at("force_N")), std::nullopt, contact_from(p, "contact")});
     e.error_estimate = estimate_from(j.at("error_estimate"));
     if (j.contains("other_tools"))
       for (const auto& o : j.at("other_tools")) {
@@ -147,6 +173,7 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
         t.volume_change = o.at("volume_change");
         t.statistics.iterations = o.at("iterations");
         t.statistics.solve_time_s = o.at("solve_time_s");
+        t.contact = contact_from(o, "contact");
         e.other_tools.push_back(std::move(t));
       }
     return e;
@@ -161,7 +188,9 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
   const auto& st = s.statistics;
   nlohmann::json fd = nlohmann::json::array();
   for (const auto& p : e.force_depth)
-    fd.push_back({{"depth_m", p.depth_m}, {"force_N", vec(p.force_n)}});
+    fd.push_back({{"depth_m", p.depth_m},
+                  {"force_N", vec(p.force_n)},
+                  {"contact", contact_json(p.contact)}});
   nlohmann::json j = {{"version", cache_version},
                       {"key", key},
                       {"mesh_vertices", matrix_json(e.mesh.vertices)},
@@ -184,6 +213,7 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                         {"assemble_time_s", st.assemble_time_s},
                         {"solve_time_s", st.solve_time_s}}},
                       {"force_depth", fd},
+                      {"contact", contact_json(s.contact)},
                       {"error_estimate", estimate_json(e.error_estimate)}};
   if (!e.other_tools.empty()) {
     j["other_tools"] = nlohmann::json::array();
@@ -193,7 +223,8 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                                   {"solver", t.solver},
                                   {"volume_change", t.volume_change},
                                   {"iterations", t.statistics.iterations},
-                                  {"solve_time_s", t.statistics.solve_time_s}});
+                                  {"solve_time_s", t.statistics.solve_time_s},
+                                  {"contact", contact_json(t.contact)}});
   }
   std::filesystem::create_directories(directory);
   const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(j);

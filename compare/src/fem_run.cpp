@@ -47,10 +47,19 @@ void check_mesh_cost(const Problem& problem, const fem_reference::MeshOptions& o
 
 }  // namespace
 
+fem_reference::SphereObstacle tool_obstacle(const ToolPlacement& tool) {
+  fem_reference::SphereObstacle sphere;
+  sphere.name = "tool";
+  sphere.center = tool.pushed_center();
+  sphere.radius = tool.radius;
+  sphere.push_direction = -tool.outward_normal;
+  return sphere;
+}
+
 void check_no_rigid_motion(const Problem& problem, const fem_reference::VolumeMesh& mesh,
                            const std::optional<ToolPlacement>& tool) {
   std::optional<fem_reference::Support> tool_support;
-  if (tool) tool_support = tool_patch_support(*tool);
+  if (tool && !tool->frictionless) tool_support = tool_patch_support(*tool);
   std::vector<Eigen::Vector3d> held;
   int fixed = 0;
   for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
@@ -116,7 +125,7 @@ std::vector<bool> prescribed_surface_vertices(const Problem& problem,
   const auto& s = problem.surface;
   std::vector<bool> prescribed(static_cast<std::size_t>(s.num_vertices()), false);
   std::optional<fem_reference::Support> tool_support;
-  if (tool) tool_support = tool_patch_support(*tool);
+  if (tool && !tool->frictionless) tool_support = tool_patch_support(*tool);
   for (Eigen::Index v = 0; v < s.num_vertices(); ++v) {
     const Eigen::Vector3d x = s.vertices.row(v).transpose();
     prescribed[v] = problem.fixed_region(x) || (tool_support && tool_support->region(x));
@@ -140,7 +149,8 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
                                     ? fem_reference::Preconditioner::boomer_amg
                                     : fem_reference::Preconditioner::gamg;
   // The tool first: a node caught by both keeps the tool's displacement.
-  if (tool) model.supports.push_back(tool_patch_support(*tool));
+  if (tool && !tool->frictionless) model.supports.push_back(tool_patch_support(*tool));
+  if (tool && tool->frictionless) model.obstacles.push_back(tool_obstacle(*tool));
   model.supports.push_back(fem_reference::fixed_support("fixed", problem.fixed_region));
 
   const auto& patch = p.loads.patch_force;
@@ -187,6 +197,11 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
           "the FEM reference is not in equilibrium after the BoomerAMG fallback (|Σ reactions + "
           "loads| / |loads| = " +
           std::to_string(fem->equilibrium_defect()) + "): " + e.what());
+  } catch (const fem_reference::FemError& e) {
+    // A contact that cycles or does not settle: which load, in the case's words.
+    if (!tool || !tool->frictionless) throw;
+    throw fem_reference::FemError(p.file.string() + ": loads/tool at depth " +
+                                  std::to_string(tool->depth) + " m: " + e.what());
   } catch (const std::invalid_argument& e) {
     // The FEM's own input checks (a support or traction that catches nothing) in the case's words.
     const std::string what = e.what();
@@ -200,7 +215,12 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
   solution.vertex_displacement = fem_solved.vertex_displacements();
   solution.surface_displacement =
       solution.vertex_displacement.topRows(problem.surface.num_vertices());
-  if (tool) solution.tool_force = -fem_solved.reaction_force("tool");
+  if (tool && tool->frictionless) {
+    solution.contact = fem_solved.contact("tool");
+    solution.tool_force = -solution.contact->force;
+  } else if (tool) {
+    solution.tool_force = -fem_solved.reaction_force("tool");
+  }
   solution.statistics = fem_solved.statistics();
   solution.volume_change = volume_change(problem.surface, solution.surface_displacement);
   return solution;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface_generators.hpp"
@@ -103,6 +104,58 @@ ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s
   return t;
 }
 
+/// Distance from x to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+double distance_to_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = x - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return (x - a).norm();
+  const Eigen::Vector3d bp = x - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return (x - b).norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (x - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = x - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return (x - c).norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (x - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (x - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denominator = 1.0 / (va + vb + vc);
+  return (x - (a + ab * vb * denominator + ac * vc * denominator)).norm();
+}
+
+/// The closest approach of the surface to `center`.
+double distance_to_surface(const cases::Surface& s, const Eigen::Vector3d& center) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index t = 0; t < s.num_triangles(); ++t)
+    nearest = std::min(nearest, distance_to_triangle(center, s.vertices.row(s.triangles(t, 0)),
+                                                     s.vertices.row(s.triangles(t, 1)),
+                                                     s.vertices.row(s.triangles(t, 2))));
+  return nearest;
+}
+
+// A contact tool must start outside the body (touching it) and reach it at full depth: a sphere
+// already inside would be pushed out, not in, and one that misses compares nothing.
+void check_contact_start(const cases::CaseParameters& p, const cases::Surface& s,
+                         const ToolPlacement& t, const Eigen::Vector3d& d) {
+  const std::string where = p.file.string() + ": loads/tool: the contact tool at direction (" +
+                            std::to_string(d.x()) + ", " + std::to_string(d.y()) + ", " +
+                            std::to_string(d.z()) + ")";
+  const double start = distance_to_surface(s, t.contact_point + t.radius * t.outward_normal);
+  if (start < (1 - 1e-3) * t.radius)
+    throw cases::InputError(where +
+                            " starts inside the body: before it is pushed the surface comes " +
+                            std::to_string(t.radius - start) + " m inside its sphere (radius " +
+                            std::to_string(t.radius) +
+                            " m; the surface is concave there: choose another direction "
+                            "or a smaller radius)");
+  if (distance_to_surface(s, t.pushed_center()) >= t.radius)
+    throw cases::InputError(where + " misses the body at depth " + std::to_string(t.depth) + " m");
+}
+
 // A patch force that pulls only fixed nodes moves nothing in either model: the comparison would
 // divide by a reference that does not move.
 void check_patch_force(const Problem& problem) {
@@ -196,13 +249,6 @@ Problem make_problem(const cases::CaseParameters& parameters) {
                             ": support: the fixed region contains the whole surface");
 
   if (parameters.loads.tool.enabled) {
-    // Both models press the tool as a prescribed patch; reading `contact` and doing that anyway
-    // would compare something other than what the case asks for.
-    if (parameters.loads.tool.mode == cases::ToolParameters::Mode::contact)
-      throw cases::InputError(
-          parameters.file.string() +
-          ": loads/tool/mode = contact: frictionless tool contact is not implemented in the FEM "
-          "reference, so the two models could not be compared under it; use mode = prescribed");
     const Eigen::MatrixX3d normals = cases::vertex_normals(s);
     for (const auto& d : parameters.loads.tool.directions) {
       ToolPlacement t = place_tool(parameters, s, normals, problem.centroid, d);
@@ -210,6 +256,8 @@ Problem make_problem(const cases::CaseParameters& parameters) {
         throw cases::InputError(parameters.file.string() + ": loads/tool: the tool at direction (" +
                                 std::to_string(d.x()) + ", " + std::to_string(d.y()) + ", " +
                                 std::to_string(d.z()) + ") presses on a fixed node");
+      t.frictionless = parameters.loads.tool.mode == cases::ToolParameters::Mode::contact;
+      if (t.frictionless) check_contact_start(parameters, s, t, d);
       problem.tools.push_back(t);
     }
   }

@@ -46,6 +46,20 @@ nlohmann::json curve_json(const std::vector<ForceDepthPoint>& curve) {
   return points;
 }
 
+nlohmann::json contact_json(const std::optional<fem_reference::ContactReport>& c) {
+  if (!c) return nullptr;
+  return {{"active_nodes", c->active_nodes},
+          {"active_set_iterations", c->iterations},
+          {"contact_radius_m", c->contact_radius},
+          {"outermost_contact_node_radius_m", c->outermost_node_radius},
+          {"max_penetration_m", c->max_penetration}};
+}
+
+std::optional<ToolPlacement> tool_of(const CaseRun& run, int load) {
+  if (load >= static_cast<int>(run.problem.tools.size())) return std::nullopt;
+  return run.problem.tools[static_cast<std::size_t>(load)];
+}
+
 nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o) {
   const ZonedErrorMetrics& e = o.errors;
   return {{"tool", tool},
@@ -61,6 +75,8 @@ nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o)
           {"volume_change", o.volume_change},
           {"inverted_elements", json_or_null(o.inverted_elements)},
           {"force_depth_monotone", json_or_null(o.force_depth_monotone)},
+          {"force_depth_exponent",
+           json_or_null(force_depth_exponent(o.force_depth, tool_of(run, tool)))},
           {"force_depth", curve_json(o.force_depth)}};
 }
 
@@ -146,22 +162,29 @@ nlohmann::json summary_json(const CaseRun& run) {
                     : vec(mean_displacement(run.fem.surface_displacement, patch));
   nlohmann::json curve = nlohmann::json::array();
   for (const auto& pt : run.fem_force_depth)
-    curve.push_back({{"depth_m", pt.depth_m}, {"force_N", vec(pt.force_n)}});
+    curve.push_back({{"depth_m", pt.depth_m},
+                     {"force_N", vec(pt.force_n)},
+                     {"contact", contact_json(pt.contact)}});
   fem["force_depth"] = curve;
   fem["force_depth_monotone"] = json_or_null(run.fem_force_depth_monotone);
+  fem["force_depth_exponent"] =
+      json_or_null(force_depth_exponent(run.fem_force_depth, tool_of(run, 0)));
+  fem["contact"] = contact_json(run.fem.contact);
 
   if (!run.other_tools.empty()) {
     nlohmann::json loads = nlohmann::json::array();
     loads.push_back({{"tool", 0},
                      {"reaction_force_N", vec(run.fem.tool_force)},
                      {"iterations", st.iterations},
-                     {"solve_time_s", st.solve_time_s}});
+                     {"solve_time_s", st.solve_time_s},
+                     {"contact", contact_json(run.fem.contact)}});
     loads.back().update(estimate_at(run, 0));
     for (const auto& load : run.other_tools) {
       loads.push_back({{"tool", load.tool},
                        {"reaction_force_N", vec(load.fem.tool_force)},
                        {"iterations", load.fem.statistics.iterations},
-                       {"solve_time_s", load.fem.statistics.solve_time_s}});
+                       {"solve_time_s", load.fem.statistics.solve_time_s},
+                       {"contact", contact_json(load.fem.contact)}});
       loads.back().update(estimate_at(run, static_cast<std::size_t>(load.tool)));
     }
     fem["loads"] = loads;
@@ -200,6 +223,8 @@ nlohmann::json summary_json(const CaseRun& run) {
          {"newton_iterations", v.newton_iterations},
          {"force_depth", fd},
          {"force_depth_monotone", json_or_null(v.force_depth_monotone)},
+         {"force_depth_exponent",
+          json_or_null(force_depth_exponent(v.force_depth, tool_of(run, 0)))},
          {"inverted_elements", json_or_null(v.inverted_elements)},
          {"warnings", v.warnings},
          {"parameters", v.parameters}});
@@ -214,7 +239,8 @@ nlohmann::json summary_json(const CaseRun& run) {
                      {"contact_point_m", vec(t.contact_point)},
                      {"outward_normal", vec(t.outward_normal)},
                      {"radius_m", t.radius},
-                     {"depth_m", t.depth}});
+                     {"depth_m", t.depth},
+                     {"mode", t.frictionless ? "contact" : "bonded"}});
   return {{"case", p.name},
           {"case_file", p.file.string()},
           {"git_revision", git_revision()},

@@ -17,6 +17,7 @@
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/static_solver.hpp"
+#include "msfem/massspring/surface_contact.hpp"
 #include "msfem/massspring/surface_geometry.hpp"
 #include "msfem/massspring/tool_contact.hpp"
 #include "msfem/massspring/topology_builders.hpp"
@@ -194,11 +195,23 @@ void check_variants_fit(const Problem& problem) {
 }
 
 void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool) {
-  const fem_reference::Support support = tool_patch_support(tool);
   ms::MassSpringModel& model = *variant.model;
   for (int node : variant.tool_patch)
     model.release_node(node);
   variant.tool_patch.clear();
+  if (tool.frictionless) {
+    // The sphere against the surface's triangles, at the penalty activate_surface_contact picks
+    // from the network's stiffness (the same at every depth of the loading path).
+    ms::ToolIndentation indent;
+    indent.contact_point = tool.contact_point;
+    indent.inward_direction = -tool.outward_normal;
+    indent.radius = tool.radius;
+    indent.depth = tool.depth;
+    variant.contact_pressure_penalty =
+        ms::activate_surface_contact(model, indent, variant.contact_pressure_penalty);
+    return;
+  }
+  const fem_reference::Support support = tool_patch_support(tool);
   // The very same patch and displacement as the FEM's tool support, node for node: the case's
   // surface vertices, and tet_edges' extra surface nodes where it shares the FEM's refined mesh.
   const auto& network = model.network();
@@ -295,6 +308,8 @@ StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::Ve
       model.surface_displacement(r.x).topRows(variant.case_surface_vertices);
   if (!variant.tool_patch.empty())
     solution.tool_force = ms::patch_reaction_force(model, r.x, variant.tool_patch);
+  else if (model.contact())
+    solution.tool_force = ms::contact_reaction_force(model, r.x);
   return solution;
 }
 
@@ -315,10 +330,11 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
   }
   t.dt_s = timing.dt_s > 0 ? timing.dt_s : 0.5 * t.stable_dt_s;
 
-  // The real-time path: the fast stepper for symplectic Euler (it has no tool contact, but the
-  // prescribed patch is a support it honours); the generic integrator otherwise, and for volume
-  // preservation, which the fast kernels do not have.
-  const bool fast = kind == ms::IntegratorKind::symplectic_euler && !model.volume();
+  // The real-time path: the fast stepper for symplectic Euler (the prescribed patch is a support
+  // it honours); the generic integrator otherwise, and for volume preservation and the contact
+  // tool, which the fast kernels do not have.
+  const bool fast =
+      kind == ms::IntegratorKind::symplectic_euler && !model.volume() && !model.contact();
   std::unique_ptr<ms::FastExplicitStepper> stepper;
   ms::Integrator integrator(kind);
   ms::State state = start;

@@ -19,7 +19,8 @@ namespace {
 // The geometry and material of the measurement that showed the bonded patch's 0.70: a 5 mm tool
 // on brain-like tissue.
 constexpr double tool_radius = 5e-3, youngs = 3e3, nu = 0.45;
-//// The block's half-width in contact radii: with Boussinesq's far field on its faces, 8 and 12 give
+//// The block's half-width in contact radii: with Boussinesq's far field on its faces, 8 and 12
+///give
 /// forces 0.1 % apart.
 constexpr double block_radii = 8.0;
 constexpr double growth_per_radius = 1.0;
@@ -139,8 +140,7 @@ VerificationCheck check_hertz_contact(unsigned int degree, const std::vector<dou
   double radius_error = 0.0;
   for (const ContactRow& row : check.contact) {
     check.rel_l2_error = std::max(check.rel_l2_error, relative(row.force, row.hertz_force));
-    radius_error =
-        std::max(radius_error, relative(row.contact_radius, row.sneddon_contact_radius));
+    radius_error = std::max(radius_error, relative(row.contact_radius, row.sneddon_contact_radius));
   }
   const double sneddon_error = check.levels.back().rel_l2_error;
   if (check.levels.size() >= 2) check.observed_order = detail::observed_order(check.levels);

@@ -373,7 +373,8 @@ void PetscLinearSystem::set_node_terms(const std::vector<PetscInt>& node_rows,
   MSFEM_PETSC(VecCopy(base_rhs_, rhs_));
   for (std::size_t k = 0; k < node_rows.size(); ++k) {
     const std::array<PetscInt, 3> rows{{node_rows[k], node_rows[k] + 1, node_rows[k] + 2}};
-    MSFEM_PETSC(MatSetValues(matrix_, 3, rows.data(), 3, rows.data(), blocks[k].data(), ADD_VALUES));
+    MSFEM_PETSC(
+        MatSetValues(matrix_, 3, rows.data(), 3, rows.data(), blocks[k].data(), ADD_VALUES));
     MSFEM_PETSC(VecSetValues(rhs_, 3, rows.data(), rhs[k].data(), ADD_VALUES));
   }
   finish_assembly();
@@ -437,6 +438,9 @@ KrylovReport PetscLinearSystem::solve(const SolverSettings& settings,
     // preconditions well, and its set-up costs more than the extra iterations.
     MSFEM_PETSC(KSPSetOperators(kept_->ksp, matrix_, matrix_));
     MSFEM_PETSC(KSPSetReusePreconditioner(kept_->ksp, PETSC_TRUE));
+    if (settings.preconditioner != Preconditioner::mumps)
+      MSFEM_PETSC(KSPSetTolerances(kept_->ksp, settings.relative_tolerance, 1e-300, 1e10,
+                                   settings.max_iterations));
   } else {
     state = configure(settings, owned_node_coordinates);
   }

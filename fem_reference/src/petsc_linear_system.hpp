@@ -72,8 +72,9 @@ class PetscLinearSystem {
   std::vector<double> owned_diagonal() const;
 
   /// matrix = base + a 3x3 block (row-major) on each listed node's diagonal, rhs = base rhs + a
-  /// 3-vector there. `node_rows` are the nodes' first (x) rows, owned by this rank; rows and columns
-  /// of prescribed components must be zero in the blocks. The solution is kept as the next start.
+  /// 3-vector there. `node_rows` are the nodes' first (x) rows, owned by this rank; rows and
+  /// columns of prescribed components must be zero in the blocks. The solution is kept as the next
+  /// start.
   void set_node_terms(const std::vector<PetscInt>& node_rows,
                       const std::vector<std::array<double, 9>>& blocks,
                       const std::vector<std::array<double, 3>>& rhs);

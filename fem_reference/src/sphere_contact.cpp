@@ -20,6 +20,8 @@ using namespace dealii;
 namespace {
 
 constexpr int dim = 3;
+/// Relative tolerance of the solves that search for the active set.
+constexpr double loose_tolerance = 1e-6;
 
 /// A boundary node that may touch an obstacle, owned by this rank.
 struct Candidate {
@@ -38,19 +40,31 @@ class ActiveSetIteration {
     collect_candidates();
     std::vector<double> u = initial_displacement();
     std::vector<char> active = active_flags(u);
+    start_at_hertz_radius(active);
+    push_out_along_axis(active, u);
     std::vector<std::vector<char>> history{active};
     detail::KrylovReport total;
     const int max_iterations = max_allowed_iterations();
+    // Inexact Newton: the active set is found with loose solves (from the last solution, a few
+    // Krylov iterations each); once it repeats, one solve to the case's tolerance confirms it.
+    SolverSettings loose = p_.model.solver;
+    loose.relative_tolerance = std::max(loose.relative_tolerance, loose_tolerance);
+    bool accurate = false;
     for (int iteration = 1;; ++iteration) {
       set_penalties(active, u);
-      const detail::KrylovReport report = p_.linear_system->solve(p_.model.solver, coordinates);
+      const detail::KrylovReport report =
+          p_.linear_system->solve(accurate ? p_.model.solver : loose, coordinates);
       total.iterations += report.iterations;
       total.residual_norm = report.residual_norm;
       u = p_.linear_system->gathered_solution();
       const std::vector<char> next = active_flags(u);
       if (globally_equal(next, active)) {
-        finish(u, iteration);
-        return total;
+        if (accurate) {
+          finish(u, iteration);
+          return total;
+        }
+        accurate = true;
+        continue;
       }
       for (std::size_t j = 0; j + 1 < history.size(); ++j)
         if (globally_equal(next, history[j])) throw cycling(active, next, iteration);
@@ -61,7 +75,9 @@ class ActiveSetIteration {
   }
 
  private:
-  const SphereObstacle& obstacle(const Candidate& c) const { return p_.model.obstacles[c.obstacle]; }
+  const SphereObstacle& obstacle(const Candidate& c) const {
+    return p_.model.obstacles[c.obstacle];
+  }
   Eigen::Vector3d reference_position(std::size_t dof) const {
     return to_eigen(p_.dof_support_points[dof]);
   }
@@ -112,6 +128,47 @@ class ActiveSetIteration {
     return u;
   }
 
+  double axis_distance(const Candidate& c) const {
+    const Eigen::Vector3d e = obstacle(c).push_direction.normalized();
+    const Eigen::Vector3d w = reference_position(c.first_dof) - obstacle(c).center;
+    return (w - w.dot(e) * e).norm();
+  }
+
+  /// The first active set: of the nodes the sphere overlaps (out to radius c from its axis), those
+  /// within c / sqrt(2), Hertz's contact radius sqrt(R d) against the overlap's sqrt(2 R d). From
+  /// the whole overlap the iteration first releases about half the nodes and then takes some back;
+  /// from here it needs about half the iterations.
+  void start_at_hertz_radius(std::vector<char>& active) const {
+    std::vector<double> overlap(p_.model.obstacles.size(), 0.0);
+    for (std::size_t k = 0; k < candidates_.size(); ++k)
+      if (active[k])
+        overlap[candidates_[k].obstacle] =
+            std::max(overlap[candidates_[k].obstacle], axis_distance(candidates_[k]));
+    for (double& c : overlap)
+      c = Utilities::MPI::max(c, p_.communicator);
+    for (std::size_t k = 0; k < candidates_.size(); ++k)
+      if (active[k] && axis_distance(candidates_[k]) > overlap[candidates_[k].obstacle] / M_SQRT2)
+        active[k] = 0;
+  }
+
+  /// The first linearisation: each node inside a sphere taken to where the sphere, pushed in
+  /// along its axis, would have carried it (onto its far side along the axis), so that its normal
+  /// points into the body as the tool's does. Normals from the rest positions would point sideways
+  /// near the axis of a deep press and push the surface apart.
+  void push_out_along_axis(const std::vector<char>& active, std::vector<double>& u) const {
+    for (std::size_t k = 0; k < candidates_.size(); ++k) {
+      if (!active[k]) continue;
+      const Candidate& c = candidates_[k];
+      const Eigen::Vector3d e = obstacle(c).push_direction.normalized();
+      const Eigen::Vector3d w = reference_position(c.first_dof) - obstacle(c).center;
+      const double b = e.dot(w), r = obstacle(c).radius;
+      // The larger root of |w + t e| = r.
+      const double t = -b + std::sqrt(std::max(0.0, b * b + r * r - w.squaredNorm()));
+      for (int a = 0; a < dim; ++a)
+        if (!prescribed(c.first_dof + a)) u[c.first_dof + a] += t * e[a];
+    }
+  }
+
   /// Signed distance of the node's present position from the sphere's surface (negative inside).
   double gap(const Candidate& c, const std::vector<double>& u) const {
     const Eigen::Vector3d x = reference_position(c.first_dof) + node_value(u, c.first_dof);
@@ -122,14 +179,24 @@ class ActiveSetIteration {
   /// saw, n . u - t along its normal: the true gap also grows by |tangential motion|^2 / 2R since
   /// the normal was taken, which after the first solve exceeds the penalty's penetration by orders
   /// of magnitude and would release the whole contact; at the fixed point the two agree.
+  /// A node changes state only when its gap is beyond a band of a hundredth of the deepest
+  /// penetration: nodes at the edge of the contact, whose gap is within the solver's error of
+  /// zero, would otherwise flip in and out for ever. A node kept in contact may pull, or one kept
+  /// out may enter, by that band: a hundredth of a node's contact force.
   std::vector<char> active_flags(const std::vector<double>& u) const {
+    double deepest = 0.0;
+    for (std::size_t k = 0; k < active_.size(); ++k)
+      if (active_[k])
+        deepest = std::max(deepest,
+                           targets_[k] - normals_[k].dot(node_value(u, candidates_[k].first_dof)));
+    const double band = 1e-2 * Utilities::MPI::max(deepest, p_.communicator);
     std::vector<char> flags(candidates_.size(), 0);
     for (std::size_t k = 0; k < candidates_.size(); ++k) {
       const bool was_active = k < active_.size() && active_[k];
-      const double g = was_active ? normals_[k].dot(node_value(u, candidates_[k].first_dof)) -
-                                        targets_[k]
-                                  : gap(candidates_[k], u);
-      flags[k] = g < 0.0;
+      const double g = was_active
+                           ? normals_[k].dot(node_value(u, candidates_[k].first_dof)) - targets_[k]
+                           : gap(candidates_[k], u);
+      flags[k] = was_active ? g < band : g < -band;
     }
     return flags;
   }
@@ -145,8 +212,9 @@ class ActiveSetIteration {
     const Eigen::Vector3d u0 = node_value(u, c.first_dof);
     const Eigen::Vector3d w = reference_position(c.first_dof) + u0 - obstacle(c).center;
     const double rho = w.norm();
-    // A node exactly at the centre: push it along the obstacle's axis, out of the body.
-    n = rho > 0.0 ? Eigen::Vector3d(w / rho) : Eigen::Vector3d(-obstacle(c).push_direction.normalized());
+    // A node exactly at the centre leaves the sphere along its axis, into the body.
+    n = rho > 0.0 ? Eigen::Vector3d(w / rho)
+                  : Eigen::Vector3d(obstacle(c).push_direction.normalized());
     t = n.dot(u0) - (rho - obstacle(c).radius);
   }
 
@@ -198,9 +266,7 @@ class ActiveSetIteration {
       force[o] += f;
       for (int a = 0; a < dim; ++a)
         p_.contact_dof_force.emplace_back(c.first_dof + a, f[a]);
-      const Eigen::Vector3d axis = obstacle(c).push_direction.normalized();
-      const Eigen::Vector3d w = reference_position(c.first_dof) - obstacle(c).center;
-      const double r2 = (w - w.dot(axis) * axis).squaredNorm();
+      const double r2 = std::pow(axis_distance(c), 2);
       moment0[o] += magnitude;
       moment2[o] += magnitude * r2;
       outermost[o] = std::max(outermost[o], std::sqrt(r2));

@@ -194,11 +194,11 @@ VerificationReport run_verification(const VerificationSettings& settings) {
       report.checks.push_back(check_lame(degree, nu, settings.lame_cell_sizes));
   report.checks.push_back(check_cantilever(settings.cantilever_cell_size));
   for (unsigned int degree : {1u, 2u})
-    report.checks.push_back(check_hertz_contact(degree, settings.contact_depth_ratios,
-                                                degree == 1 ? settings.contact_cells_per_radius_p1
-                                                            : settings.contact_cells_per_radius_p2));
-  report.checks.push_back(
-      check_hertz_bonded(settings.contact_depth_ratios, settings.contact_cells_per_radius_p2.back()));
+    report.checks.push_back(check_hertz_contact(
+        degree, settings.contact_depth_ratios,
+        degree == 1 ? settings.contact_cells_per_radius_p1 : settings.contact_cells_per_radius_p2));
+  report.checks.push_back(check_hertz_bonded(settings.contact_depth_ratios,
+                                             settings.contact_cells_per_radius_p2.back()));
   if (settings.locking_table)
     report.locking = locking_table(settings.lame_cell_sizes[settings.lame_cell_sizes.size() / 2],
                                    {0.3, 0.45, 0.49, 0.499});

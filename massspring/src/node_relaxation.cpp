@@ -35,12 +35,14 @@ NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
       net.num_nodes(), net.num_anchors(), 1, [&](int a, int) { return net.anchor_node[a]; },
       anchor_start_, anchors_);
   in_contact_set_.assign(net.num_nodes(), 0);
+  // A volume element's energy couples all its nodes, so it is not local to any of them: those
+  // nodes are left to Newton. So is a surface contact's (a triangle's pressure moves its three
+  // nodes together); a node contact is local.
+  in_volume_element_.assign(net.num_nodes(), 0);
+  const bool nodal_contact = dynamic_cast<const SphereContactForceField*>(model.contact());
   if (model.contact())
     for (int i : model.contact()->nodes())
-      in_contact_set_[i] = 1;
-  // A volume element's energy couples all its nodes, so it is not local to any of them: those
-  // nodes are left to Newton.
-  in_volume_element_.assign(net.num_nodes(), 0);
+      (nodal_contact ? in_contact_set_ : in_volume_element_)[i] = 1;
   if (model.volume()) {
     const Eigen::MatrixX4i& tets = model.volume()->elements().tets;
     for (Eigen::Index t = 0; t < tets.rows(); ++t)
@@ -80,7 +82,7 @@ double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vecto
     k += net.anchor_stiffness[a] * identity;
   }
   if (in_contact_set_[i]) {
-    const ToolContact& contact = *model_.contact();
+    const auto& contact = static_cast<const SphereContactForceField&>(*model_.contact());
     const Eigen::Vector3d w = p - contact.tool().center;
     const double rho = w.norm();
     const double gap = contact.tool().radius - rho;

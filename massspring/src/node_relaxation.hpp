@@ -37,7 +37,7 @@ class NodeRelaxation {
   std::vector<int> spring_start_, springs_;  // springs at each node (CSR)
   std::vector<int> anchor_start_, anchors_;  // anchors at each node (CSR)
   std::vector<char> in_contact_set_;         // node is one the tool can touch
-  std::vector<char> in_volume_element_;      // node's energy is not local (volume preservation)
+  std::vector<char> in_volume_element_;      // node's energy is not local (volume, surface contact)
 };
 
 }  // namespace msfem::massspring::detail

@@ -73,9 +73,9 @@ SurfaceContactForceField::SurfaceContactForceField(const Eigen::MatrixX3d& rest_
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
     subdivisions_.push_back(std::clamp(
         int(std::ceil(longest * sub_edges_per_radius / tool_.radius)), 1, max_subdivisions));
-    largest_triangle_radius_ = std::max(
-        largest_triangle_radius_,
-        std::max({(a - centroid).norm(), (b - centroid).norm(), (c - centroid).norm()}));
+    largest_triangle_radius_ =
+        std::max(largest_triangle_radius_,
+                 std::max({(a - centroid).norm(), (b - centroid).norm(), (c - centroid).norm()}));
     for (int k = 0; k < 3; ++k)
       on_surface[std::size_t(triangles_(t, k))] = 1;
   }
@@ -123,14 +123,14 @@ void SurfaceContactForceField::for_each_contact_point(const Eigen::VectorXd& x,
 
 void SurfaceContactForceField::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd&,
                                          Eigen::VectorXd& f) const {
-  for_each_contact_point(x, [&](int t, double b0, double b1, double b2, double coefficient,
-                                const Eigen::Vector3d& w) {
-    const double rho = w.norm();
-    const Eigen::Vector3d push = coefficient * (tool_.radius - rho) / rho * w;
-    const double b[3] = {b0, b1, b2};
-    for (int k = 0; k < 3; ++k)
-      f.segment<3>(3 * triangles_(t, k)) += b[k] * push;
-  });
+  for_each_contact_point(
+      x, [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
+        const double rho = w.norm();
+        const Eigen::Vector3d push = coefficient * (tool_.radius - rho) / rho * w;
+        const double b[3] = {b0, b1, b2};
+        for (int k = 0; k < 3; ++k)
+          f.segment<3>(3 * triangles_(t, k)) += b[k] * push;
+      });
 }
 
 double SurfaceContactForceField::potential_energy(const Eigen::VectorXd& x) const {
@@ -159,31 +159,31 @@ Eigen::Matrix3d SurfaceContactForceField::block(const Eigen::Vector3d& w,
 void SurfaceContactForceField::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd&,
                                                 const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                                                 Linearisation mode) const {
-  for_each_contact_point(x, [&](int t, double b0, double b1, double b2, double coefficient,
-                                const Eigen::Vector3d& w) {
-    const double b[3] = {b0, b1, b2};
-    Eigen::Vector3d moved = Eigen::Vector3d::Zero();
-    for (int l = 0; l < 3; ++l)
-      moved += b[l] * dx.segment<3>(3 * triangles_(t, l));
-    const Eigen::Vector3d change = coefficient * (block(w, mode) * moved);
-    for (int k = 0; k < 3; ++k)
-      df.segment<3>(3 * triangles_(t, k)) += b[k] * change;
-  });
+  for_each_contact_point(
+      x, [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
+        const double b[3] = {b0, b1, b2};
+        Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+        for (int l = 0; l < 3; ++l)
+          moved += b[l] * dx.segment<3>(3 * triangles_(t, l));
+        const Eigen::Vector3d change = coefficient * (block(w, mode) * moved);
+        for (int k = 0; k < 3; ++k)
+          df.segment<3>(3 * triangles_(t, k)) += b[k] * change;
+      });
 }
 
 void SurfaceContactForceField::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd&,
                                                  Triplets& triplets, Linearisation mode) const {
-  for_each_contact_point(x, [&](int t, double b0, double b1, double b2, double coefficient,
-                                const Eigen::Vector3d& w) {
-    const double b[3] = {b0, b1, b2};
-    const Eigen::Matrix3d k = coefficient * block(w, mode);
-    for (int p = 0; p < 3; ++p)
-      for (int q = 0; q < 3; ++q)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c)
-            triplets.emplace_back(3 * triangles_(t, p) + r, 3 * triangles_(t, q) + c,
-                                  b[p] * b[q] * k(r, c));
-  });
+  for_each_contact_point(
+      x, [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
+        const double b[3] = {b0, b1, b2};
+        const Eigen::Matrix3d k = coefficient * block(w, mode);
+        for (int p = 0; p < 3; ++p)
+          for (int q = 0; q < 3; ++q)
+            for (int r = 0; r < 3; ++r)
+              for (int c = 0; c < 3; ++c)
+                triplets.emplace_back(3 * triangles_(t, p) + r, 3 * triangles_(t, q) + c,
+                                      b[p] * b[q] * k(r, c));
+      });
 }
 
 double SurfaceContactForceField::contact_area(const Eigen::VectorXd& x) const {

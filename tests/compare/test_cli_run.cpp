@@ -293,6 +293,45 @@ TEST(CliRun, EveryToolPositionIsItsOwnLoadAndCentralSymmetryHoldsAcrossThem) {
   EXPECT_NE(read_text(out / "report.md").find("## Every tool position"), std::string::npos);
 }
 
+// Frictionless contact in both models: the FEM's active set and the springs' surface contact,
+// force-depth curves with their power-law exponents, and contact pushing harder than the adhesive
+// patch releases (the patch holds the surface up around the tool).
+TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
+  TemporaryDirectory tmp;
+  const std::string variants = " --set \"mass spring/variants=three_tier,single_layer\"";
+  const auto contact = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" +
+                                 variants + " --set loads/tool/mode=contact --out " +
+                                 (tmp / "contact").string());
+  ASSERT_EQ(contact.exit_code, 0) << contact.err;
+  const auto j = nlohmann::json::parse(read_text(tmp / "contact" / "summary.json"));
+  EXPECT_EQ(j["tools"][0]["mode"], "contact");
+  const auto& fem = j["fem"];
+  ASSERT_TRUE(fem["contact"].is_object()) << fem.dump();
+  EXPECT_GT(fem["contact"]["active_nodes"].get<int>(), 3);
+  EXPECT_LE(fem["contact"]["active_set_iterations"].get<int>(), 10);
+  EXPECT_LT(fem["contact"]["max_penetration_m"].get<double>(), 0.01 * 0.004);
+  // The contact radius lies inside the overlap's sqrt(2 R d - d^2).
+  EXPECT_LT(fem["contact"]["contact_radius_m"].get<double>(), std::sqrt(2 * 0.01 * 0.004));
+  for (const auto& point : fem["force_depth"])
+    EXPECT_TRUE(point["contact"].is_object());
+  // Contact is stiffer than linear, softer than the bonded patch's stretch: between 1 and 2.
+  const double fem_exponent = fem["force_depth_exponent"].get<double>();
+  EXPECT_GT(fem_exponent, 1.0);
+  EXPECT_LT(fem_exponent, 2.0);
+  for (const auto& v : j["variants"]) {
+    EXPECT_GT(v["reaction_force_N"][2].get<double>(), 0.0) << v["name"];
+    EXPECT_TRUE(v["force_depth_exponent"].is_number()) << v["name"];
+  }
+  const auto bonded = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" +
+                                variants + " --set loads/tool/mode=bonded --out " +
+                                (tmp / "bonded").string());
+  ASSERT_EQ(bonded.exit_code, 0) << bonded.err;
+  const auto b = nlohmann::json::parse(read_text(tmp / "bonded" / "summary.json"));
+  EXPECT_EQ(b["tools"][0]["mode"], "bonded");
+  EXPECT_TRUE(b["fem"]["contact"].is_null());
+  EXPECT_NE(b["fem"]["cache_key"], fem["cache_key"]);
+}
+
 TEST(CliParams, PrintsTheWholeLanguage) {
   const auto r = run_msfem("params");
   ASSERT_EQ(r.exit_code, 0);

@@ -39,9 +39,9 @@ TEST(RefineUniformly, SplitsEveryCellIntoEightOfTheSameVolumeKeepingTheVertices)
   EXPECT_GT(cell_quality(finer).minCoeff(), 0.3 * cell_quality(mesh).minCoeff());
 }
 
-// A ball with its bottom cap fixed, sagging under gravity: the difference to the solve on the refined
-// mesh (the estimate msfem reports as the reference's own error) is within a factor 3 of the
-// actual error against a solve two refinements finer, for P1 and P2.
+// A ball with its bottom cap fixed, sagging under gravity: the difference to the solve on the
+// refined mesh (the estimate msfem reports as the reference's own error) is within a factor 3 of
+// the actual error against a solve two refinements finer, for P1 and P2.
 TEST(RefineUniformly, DifferenceToTheRefinedSolveEstimatesTheDiscretisationError) {
   const testing::TestSurface surface = testing::icosphere(2, 0.05);
   MeshOptions options;

@@ -24,9 +24,8 @@ using testing::perturbed;
 TEST(SurfaceContact, JacobiansAndEnergyMatchFiniteDifferences) {
   const auto mesh = icosphere(2, 0.05);
   // A 4 mm tool pressed 1 mm into the sphere between nodes (edges ~ 15 mm).
-  const SurfaceContactForceField contact(mesh.vertices, mesh.triangles,
-                                         SphereTool{{0.003, 0.002, 0.05 + 0.004 - 0.001}, 0.004},
-                                         2e6);
+  const SurfaceContactForceField contact(
+      mesh.vertices, mesh.triangles, SphereTool{{0.003, 0.002, 0.05 + 0.004 - 0.001}, 0.004}, 2e6);
   const Eigen::VectorXd x = perturbed(flatten(mesh.vertices), 2e-4, 21);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
   contact.add_force(x, Eigen::VectorXd::Zero(x.size()), f);
@@ -136,12 +135,12 @@ TEST(SurfaceContact, BroadPhaseFollowsTheSurfaceAsItMoves) {
 
 TEST(SurfaceContact, RefusesBadInput) {
   const auto mesh = icosphere(1, 0.05);
-  EXPECT_THROW(SurfaceContactForceField(mesh.vertices, mesh.triangles, SphereTool{{0, 0, 0}, 0.0},
-                                        1.0),
-               ModelError);
-  EXPECT_THROW(SurfaceContactForceField(mesh.vertices, mesh.triangles,
-                                        SphereTool{{0, 0, 0}, 0.01}, -1.0),
-               ModelError);
+  EXPECT_THROW(
+      SurfaceContactForceField(mesh.vertices, mesh.triangles, SphereTool{{0, 0, 0}, 0.0}, 1.0),
+      ModelError);
+  EXPECT_THROW(
+      SurfaceContactForceField(mesh.vertices, mesh.triangles, SphereTool{{0, 0, 0}, 0.01}, -1.0),
+      ModelError);
   Eigen::MatrixX3i bad = mesh.triangles;
   bad(0, 0) = int(mesh.vertices.rows());
   EXPECT_THROW(SurfaceContactForceField(mesh.vertices, bad, SphereTool{{0, 0, 0}, 0.01}, 1.0),

@@ -47,6 +47,7 @@ struct SupportParameters {
 /// vertex that lies farthest from the vertex centroid along `direction`.
 struct ToolParameters {
   bool enabled = true;
+  /// prescribed: the bonded patch (case value `bonded` or `prescribed`); contact: frictionless.
   enum class Mode { prescribed, contact };
   Mode mode = Mode::prescribed;
   std::vector<Eigen::Vector3d> directions = {Eigen::Vector3d::UnitZ()};

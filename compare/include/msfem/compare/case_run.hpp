@@ -35,6 +35,7 @@ struct ForceDepthPoint {
   double depth_m = 0.0;
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
   std::optional<int> inverted_elements;  ///< a volumetric variant's inverted tetrahedra there
+  std::optional<fem_reference::ContactReport> contact;  ///< the FEM's frictionless tool there
 };
 
 /// One variant pressed at one of the case's tool positions, at the case's depth, reached along the
@@ -125,6 +126,12 @@ std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& v
 /// own estimated error there: the reference does not resolve the variant's error in them.
 std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
                                             int load = 0);
+
+/// The exponent n of the power law F = c d^n fitted (least squares in log-log) to the curve's
+/// force along the tool's outward normal: 1.5 for Hertz, 1 for a linear spring. None without a
+/// tool, with fewer than two points, or where a force does not push the tool back.
+std::optional<double> force_depth_exponent(const std::vector<ForceDepthPoint>& curve,
+                                           const std::optional<ToolPlacement>& tool);
 
 /// Whether the force the tissue exerts on the tool, along the tool's outward normal, grows strictly
 /// from each depth of the curve to the next deeper one; none without a tool or with fewer than

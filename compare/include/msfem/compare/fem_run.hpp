@@ -29,6 +29,8 @@ struct FemSolution {
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();  ///< force the tissue exerts on the tool, N
   double volume_change = 0.0;  ///< deformed / rest enclosed volume − 1 of the surface
   fem_reference::SolveStatistics statistics;
+  /// With a frictionless tool: its contact (force, active nodes, radius, penetration).
+  std::optional<fem_reference::ContactReport> contact;
   std::string solver;  ///< the solver that produced it (the case's, or the fallback and why)
 };
 
@@ -38,6 +40,9 @@ struct FemSolution {
 /// instead of failing. solve_fem checks it; a command checks it once before its first solve.
 void check_no_rigid_motion(const Problem& problem, const fem_reference::VolumeMesh& mesh,
                            const std::optional<ToolPlacement>& tool);
+
+/// The frictionless tool as the FEM's rigid sphere, named "tool": every boundary node a candidate.
+fem_reference::SphereObstacle tool_obstacle(const ToolPlacement& tool);
 
 /// Solves the problem's FEM for `tool` (none: gravity and patch force only).
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,

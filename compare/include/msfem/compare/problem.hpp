@@ -20,6 +20,7 @@ struct ToolPlacement {
   Eigen::Vector3d outward_normal = Eigen::Vector3d::UnitZ();  ///< the vertex normal there
   double radius = 0.0;
   double depth = 0.0;
+  bool frictionless = false;  ///< loads/tool/mode = contact; otherwise the bonded patch
   /// Centre of the sphere at full depth: contact + (radius − depth) n.
   Eigen::Vector3d pushed_center() const {
     return contact_point + (radius - depth) * outward_normal;

@@ -41,7 +41,9 @@ inline constexpr const char* volume_group = "volume";
 struct BuiltVariant {
   std::string name;
   std::unique_ptr<massspring::MassSpringModel> model;
-  std::vector<int> tool_patch;  ///< nodes the tool prescribes
+  std::vector<int> tool_patch;  ///< nodes the tool prescribes (the bonded patch)
+  /// The frictionless tool's pressure penalty (Pa/m), chosen at its first depth and kept.
+  double contact_pressure_penalty = 0.0;
   /// The case's surface vertices are the first this many surface nodes (tet_edges on the FEM's
   /// mesh refined at the tool has more; only these are compared).
   Eigen::Index case_surface_vertices = 0;

@@ -18,11 +18,11 @@ struct RefinementLevel {
 
 /// One depth of a contact check: the FEM's force and contact radius against the closed forms.
 struct ContactRow {
-  double depth_ratio = 0.0;    ///< d / R
-  double force = 0.0;          ///< N, the whole half-space (four times the quarter model's)
-  double hertz_force = 0.0;    ///< N
-  double sneddon_force = 0.0;  ///< N
-  double contact_radius = 0.0; ///< m (ContactReport::contact_radius); 0 for the bonded patch
+  double depth_ratio = 0.0;     ///< d / R
+  double force = 0.0;           ///< N, the whole half-space (four times the quarter model's)
+  double hertz_force = 0.0;     ///< N
+  double sneddon_force = 0.0;   ///< N
+  double contact_radius = 0.0;  ///< m (ContactReport::contact_radius); 0 for the bonded patch
   double sneddon_contact_radius = 0.0;  ///< m
   int active_nodes = 0;
   int iterations = 0;            ///< active-set iterations
