@@ -66,11 +66,19 @@ class ActiveSetIteration {
         accurate = true;
         continue;
       }
+      std::vector<char> following = next;
       for (std::size_t j = 0; j + 1 < history.size(); ++j)
-        if (globally_equal(next, history[j])) throw cycling(active, next, iteration);
-      if (iteration >= max_iterations) throw not_settled(active, next, iteration);
-      history.push_back(next);
-      active = next;
+        if (globally_equal(next, history[j])) {
+          // A few edge nodes can still alternate (their gap changes sign with their neighbours'
+          // state). The first time, the switching nodes are held in contact for good: each pulls
+          // at most its penalty times a gap of the order of the band. A second cycle is an error.
+          if (holding_) throw cycling(active, next, iteration);
+          hold_switching_nodes(active, following);
+          break;
+        }
+      if (iteration >= max_iterations) throw not_settled(active, following, iteration);
+      history.push_back(following);
+      active = following;
     }
   }
 
@@ -179,6 +187,13 @@ class ActiveSetIteration {
   /// saw, n . u - t along its normal: the true gap also grows by |tangential motion|^2 / 2R since
   /// the normal was taken, which after the first solve exceeds the penalty's penetration by orders
   /// of magnitude and would release the whole contact; at the fixed point the two agree.
+  void hold_switching_nodes(const std::vector<char>& active, std::vector<char>& next) {
+    held_.assign(candidates_.size(), 0);
+    for (std::size_t k = 0; k < candidates_.size(); ++k)
+      if (active[k] != next[k]) held_[k] = next[k] = 1;
+    holding_ = true;
+  }
+
   /// A node changes state only when its gap is beyond a band of a hundredth of the deepest
   /// penetration: nodes at the edge of the contact, whose gap is within the solver's error of
   /// zero, would otherwise flip in and out for ever. A node kept in contact may pull, or one kept
@@ -192,6 +207,10 @@ class ActiveSetIteration {
     const double band = 1e-2 * Utilities::MPI::max(deepest, p_.communicator);
     std::vector<char> flags(candidates_.size(), 0);
     for (std::size_t k = 0; k < candidates_.size(); ++k) {
+      if (holding_ && held_[k]) {
+        flags[k] = 1;
+        continue;
+      }
       const bool was_active = k < active_.size() && active_[k];
       const double g = was_active
                            ? normals_[k].dot(node_value(u, candidates_[k].first_dof)) - targets_[k]
@@ -325,6 +344,8 @@ class ActiveSetIteration {
   ElasticityProblem::Implementation& p_;
   std::vector<Candidate> candidates_;
   std::vector<char> active_;
+  std::vector<char> held_;  ///< nodes kept in contact after a cycle
+  bool holding_ = false;    ///< on every rank once any rank saw the cycle (the test is global)
   std::vector<Eigen::Vector3d> normals_;
   std::vector<double> targets_;
 };

@@ -167,9 +167,9 @@ TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
                                      "  set half space point = 0,0,0.04\n"
                                      "  set half space normal = 0,0,1\nend")),
        "fixed node"},
-      {write_case("contact.prm", base + "subsection loads\n  subsection tool\n"
-                                        "    set mode = contact\n  end\nend\n"),
-       "loads/tool/mode = contact"},
+      {write_case("mode.prm", base + "subsection loads\n  subsection tool\n"
+                                     "    set mode = sliding\n  end\nend\n"),
+       "mode.prm:37:"},
       {(tmp / "absent.prm").string(), "absent.prm"},
   };
   for (const auto& [file, named] : cases) {
@@ -299,9 +299,9 @@ TEST(CliRun, EveryToolPositionIsItsOwnLoadAndCentralSymmetryHoldsAcrossThem) {
 TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
   TemporaryDirectory tmp;
   const std::string variants = " --set \"mass spring/variants=three_tier,single_layer\"";
-  const auto contact = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" +
-                                 variants + " --set loads/tool/mode=contact --out " +
-                                 (tmp / "contact").string());
+  const auto contact =
+      run_msfem("run " + small_case + " --quiet --no-timing --no-cache" + variants +
+                " --set loads/tool/mode=contact --out " + (tmp / "contact").string());
   ASSERT_EQ(contact.exit_code, 0) << contact.err;
   const auto j = nlohmann::json::parse(read_text(tmp / "contact" / "summary.json"));
   EXPECT_EQ(j["tools"][0]["mode"], "contact");
@@ -322,9 +322,8 @@ TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
     EXPECT_GT(v["reaction_force_N"][2].get<double>(), 0.0) << v["name"];
     EXPECT_TRUE(v["force_depth_exponent"].is_number()) << v["name"];
   }
-  const auto bonded = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" +
-                                variants + " --set loads/tool/mode=bonded --out " +
-                                (tmp / "bonded").string());
+  const auto bonded = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" + variants +
+                                " --set loads/tool/mode=bonded --out " + (tmp / "bonded").string());
   ASSERT_EQ(bonded.exit_code, 0) << bonded.err;
   const auto b = nlohmann::json::parse(read_text(tmp / "bonded" / "summary.json"));
   EXPECT_EQ(b["tools"][0]["mode"], "bonded");
