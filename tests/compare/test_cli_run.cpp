@@ -169,7 +169,7 @@ TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
        "fixed node"},
       {write_case("mode.prm", base + "subsection loads\n  subsection tool\n"
                                      "    set mode = sliding\n  end\nend\n"),
-       "mode.prm:37:"},
+       "mode.prm:36:"},
       {(tmp / "absent.prm").string(), "absent.prm"},
   };
   for (const auto& [file, named] : cases) {
