@@ -85,6 +85,12 @@ SurfaceContactForceField::SurfaceContactForceField(const Eigen::MatrixX3d& rest_
   broad_phase_ = std::make_shared<const BroadPhase>(std::move(centroids));
 }
 
+void SurfaceContactForceField::set_pressure_penalty(double pressure_penalty) {
+  if (!(pressure_penalty > 0.0) || !std::isfinite(pressure_penalty))
+    throw ModelError("surface contact: pressure penalty must be finite and > 0");
+  pressure_penalty_ = pressure_penalty;
+}
+
 template <class Visit>
 void SurfaceContactForceField::for_each_contact_point(const Eigen::VectorXd& x,
                                                       Visit&& visit) const {
@@ -196,11 +202,14 @@ double SurfaceContactForceField::contact_area(const Eigen::VectorXd& x) const {
 double activate_surface_contact(MassSpringModel& model, const ToolIndentation& indent,
                                 double pressure_penalty) {
   const SpringNetwork& net = model.network();
-  SurfaceContactForceField probe(net.rest_positions, net.surface_triangles, indent.tool(), 1.0);
-  if (pressure_penalty <= 0.0)
-    pressure_penalty = 1000.0 * stiffest_surface_node(model) / probe.penalty_stiffness();
-  model.set_contact(SurfaceContactForceField(net.rest_positions, net.surface_triangles,
-                                             indent.tool(), pressure_penalty));
+  SurfaceContactForceField contact(net.rest_positions, net.surface_triangles, indent.tool(),
+                                   pressure_penalty > 0.0 ? pressure_penalty : 1.0);
+  if (pressure_penalty <= 0.0) {
+    // At κ = 1 the nodal stiffness is a mean node's area.
+    pressure_penalty = 1000.0 * stiffest_surface_node(model) / contact.penalty_stiffness();
+    contact.set_pressure_penalty(pressure_penalty);
+  }
+  model.set_contact(contact);
   return pressure_penalty;
 }
 

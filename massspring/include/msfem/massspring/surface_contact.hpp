@@ -40,6 +40,8 @@ class SurfaceContactForceField : public ToolContact {
   const std::vector<int>& nodes() const override { return nodes_; }
   double penalty_stiffness() const override { return pressure_penalty_ * mean_node_area_; }
   double pressure_penalty() const { return pressure_penalty_; }
+  /// κ (Pa/m), finite and > 0 (ModelError otherwise).
+  void set_pressure_penalty(double pressure_penalty);
 
   /// The contact area (m², rest measure) and the number of triangles touched at x.
   double contact_area(const Eigen::VectorXd& x) const;
