@@ -138,6 +138,11 @@ void declare_mass_spring(ParameterHandler& prm) {
   prm.declare_entry("inner tiers", "scaled", Patterns::Selection("scaled|offset"),
                     "Build inner tiers by scaling, or by offsetting along the inward normal "
                     "(safe for concave surfaces).");
+  prm.declare_entry("inner diagonals", "false", Patterns::Bool(),
+                    "Crossing diagonals between tier 2 and tier 3 as between tiers 1 and 2 "
+                    "(group tier23_diagonals). The seed links tier 2 to the fixed tier 3 by radial "
+                    "springs only, so the outer shell turns about the core under any lateral "
+                    "force; false keeps the seed's springs.");
   prm.leave_subsection();
   prm.enter_subsection("skeleton");
   prm.declare_entry("control points", "0", Patterns::Integer(0),
@@ -147,6 +152,18 @@ void declare_mass_spring(ParameterHandler& prm) {
   // lie inside the fixed core, and the default case runs as `msfem params` prints it.
   prm.declare_entry("draw factor", "0.45", Patterns::Double(0.0, 1.0),
                     "Control points are drawn toward the centroid by this factor.");
+  prm.leave_subsection();
+  prm.enter_subsection("contact refinement");
+  prm.declare_entry("enabled", "false", Patterns::Bool(),
+                    "Refine the case's surface around each tool before the models are built (a "
+                    "local point distribution, after the layered brain paper's), so a tool "
+                    "between the coarse surface's nodes meets several. Both models use the "
+                    "refined surface; summary.json says how many nodes it added per variant.");
+  prm.declare_entry("radius", "0", Patterns::Double(0),
+                    "Radius (m) around each tool's contact point; 0: twice the tool radius.");
+  prm.declare_entry("edge length", "0", Patterns::Double(0),
+                    "Longest surface edge (m) inside that radius; 0: the tool radius / 3 (the "
+                    "FEM's default tool cell size, so both share the surface nodes there).");
   prm.leave_subsection();
   prm.leave_subsection();
 }
@@ -371,10 +388,16 @@ CaseParameters extract(ParameterHandler& prm) {
   ms.middle_tier_scale = prm.get_double("middle tier scale");
   ms.inner_tier_scale = prm.get_double("inner tier scale");
   ms.inner_tiers = prm.get("inner tiers");
+  ms.inner_diagonals = prm.get_bool("inner diagonals");
   prm.leave_subsection();
   prm.enter_subsection("skeleton");
   ms.skeleton_control_points = prm.get_integer("control points");
   ms.skeleton_draw_factor = prm.get_double("draw factor");
+  prm.leave_subsection();
+  prm.enter_subsection("contact refinement");
+  ms.contact_refinement.enabled = prm.get_bool("enabled");
+  ms.contact_refinement.radius_m = prm.get_double("radius");
+  ms.contact_refinement.edge_m = prm.get_double("edge length");
   prm.leave_subsection();
   prm.leave_subsection();
   if (!(ms.inner_tier_scale > ms.middle_tier_scale))

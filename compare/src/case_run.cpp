@@ -155,7 +155,7 @@ StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& to
     set_tool_depth(built, at_depth(*tool, depth));
     StaticSolution at = solve_variant_static(built, x);
     x = at.x;
-    curve.push_back({depth, at.tool_force, inverted_tetrahedra(built, at.x)});
+    curve.push_back({depth, at.tool_force, inverted_tetrahedra(built, at.x), {}});
     if (depth == tool->depth) s = std::move(at);
   }
   set_tool_depth(built, *tool);
@@ -298,6 +298,7 @@ VariantResult run_variant(CaseRun& run, BuiltVariant& built, const std::vector<d
   VariantResult r;
   r.nodes = built.model->num_nodes();
   r.springs = built.model->network().num_springs();
+  r.refinement_added_nodes = built.refinement_added_nodes;
   r.warnings = built.warnings;
   r.parameters = variant_parameters(*built.model);
   std::vector<ForceDepthPoint> curve;

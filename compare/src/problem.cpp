@@ -9,6 +9,7 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
+#include "msfem/cases/surface_refinement.hpp"
 #include "msfem/cases/surface_simplification.hpp"
 #include "msfem/cases/surface_validation.hpp"
 #include "msfem/cases/units.hpp"
@@ -175,6 +176,48 @@ void check_patch_force(const Problem& problem) {
   }
 }
 
+// A local point distribution at the tool: the surface both models are built on gets edges no longer
+// than `edge` within `radius` of every tool, so a tool between the coarse nodes meets several.
+void refine_at_tools(Problem& problem) {
+  const auto& p = problem.parameters;
+  const auto& r = p.mass_spring.contact_refinement;
+  if (!r.enabled) return;
+  if (problem.tools.empty())
+    throw cases::InputError(p.file.string() +
+                            ": mass spring/contact refinement/enabled = true refines around the "
+                            "tool, but loads/tool is off");
+  double tool_radius = 0;
+  for (const ToolPlacement& t : problem.tools)
+    tool_radius = std::max(tool_radius, t.radius);
+  LocalRefinement local;
+  local.radius_m = r.radius_m > 0 ? r.radius_m : 2 * tool_radius;
+  local.edge_m = r.edge_m > 0 ? r.edge_m : tool_radius / 3;
+  // Each ball's cap needs about its area over a triangle's (√3/4 h²) triangles, half as many
+  // vertices: refuse before bisecting what no model could solve.
+  const double per_tool = M_PI * local.radius_m * local.radius_m /
+                          (std::sqrt(3.0) / 4 * local.edge_m * local.edge_m) / 2;
+  if (per_tool * double(problem.tools.size()) > 2e6)
+    throw cases::InputError(p.file.string() + ": mass spring/contact refinement: edge length " +
+                            std::to_string(local.edge_m) + " m within " +
+                            std::to_string(local.radius_m) + " m of " +
+                            std::to_string(problem.tools.size()) + " tool(s) would add about " +
+                            std::to_string(std::lround(per_tool * problem.tools.size())) +
+                            " surface vertices (at most 2,000,000): choose a longer edge");
+  std::vector<cases::RefinementBall> balls;
+  for (const ToolPlacement& t : problem.tools)
+    balls.push_back({t.contact_point, local.radius_m});
+  cases::SurfaceRefinement refined = cases::refine_near(problem.surface, balls, local.edge_m);
+  local.added_vertices = refined.added_vertices;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "surface refined to edges <= %.3g m within %.3g m of each tool (mass spring/"
+                "contact refinement): %d vertices added",
+                local.edge_m, local.radius_m, local.added_vertices);
+  problem.notes.push_back(text);
+  problem.surface = std::move(refined.surface);
+  problem.local_refinement = local;
+}
+
 }  // namespace
 
 fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
@@ -261,6 +304,7 @@ Problem make_problem(const cases::CaseParameters& parameters) {
       problem.tools.push_back(t);
     }
   }
+  refine_at_tools(problem);
   if (parameters.loads.patch_force.enabled) check_patch_force(problem);
   if (problem.tools.empty() && !parameters.loads.patch_force.enabled &&
       !(parameters.loads.gravity_m_per_s2.norm() > 0))

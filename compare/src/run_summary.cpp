@@ -60,6 +60,15 @@ std::optional<ToolPlacement> tool_of(const CaseRun& run, int load) {
   return run.problem.tools[static_cast<std::size_t>(load)];
 }
 
+// The local point distribution at the tools; null where the surface is the case's own.
+nlohmann::json refinement_json(const Problem& problem) {
+  if (!problem.local_refinement) return nullptr;
+  const LocalRefinement& r = *problem.local_refinement;
+  return {{"radius_m", r.radius_m},
+          {"edge_length_m", r.edge_m},
+          {"added_surface_vertices", r.added_vertices}};
+}
+
 nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o) {
   const ZonedErrorMetrics& e = o.errors;
   return {{"tool", tool},
@@ -197,6 +206,7 @@ nlohmann::json summary_json(const CaseRun& run) {
         {{"name", v.name},
          {"nodes", v.nodes},
          {"springs", v.springs},
+         {"contact_refinement_added_nodes", json_or_null(v.refinement_added_nodes)},
          {"rel_l2_error", v.errors.all.rel_l2_error},
          {"rms_error_m", v.errors.all.rms_error_m},
          {"max_error_m", v.errors.all.max_error_m},
@@ -254,6 +264,7 @@ nlohmann::json summary_json(const CaseRun& run) {
            {{"source", p.geometry.source},
             {"vertices", run.problem.surface.num_vertices()},
             {"triangles", run.problem.surface.num_triangles()}}},
+          {"contact_refinement", refinement_json(run.problem)},
           {"compared_vertices", run.compared_vertices.size()},
           {"tools", tools},
           {"notes", run.problem.notes},

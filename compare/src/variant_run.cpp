@@ -45,6 +45,8 @@ ms::SpringNetwork build_network(const std::string& name, const Problem& problem,
                                                           : ms::InnerTierMethod::scaling;
     o.tier2_scale = p.mass_spring.middle_tier_scale;
     o.tier3_scale = p.mass_spring.inner_tier_scale;
+    o.center = problem.centroid;  // the support's, which a refined surface's would miss
+    o.tier23_diagonals = p.mass_spring.inner_diagonals;
     o.material = material;
     return ms::build_three_tier(s.vertices, s.triangles, o);
   }
@@ -73,6 +75,7 @@ ms::SpringNetwork build_network(const std::string& name, const Problem& problem,
     const cases::Surface control = cases::simplify(s, std::min<int>(wanted, s.num_vertices()));
     ms::SkeletonOptions o;
     o.control_scale = p.mass_spring.skeleton_draw_factor;
+    o.center = problem.centroid;
     o.material = material;
     return ms::build_skeleton(s.vertices, s.triangles, control.vertices, control.triangles, o);
   }
@@ -159,6 +162,16 @@ const std::vector<std::string>& spring_groups_of(const std::string& variant) {
   return it == groups.end() ? none : it->second;
 }
 
+std::vector<std::string> spring_groups_of(const std::string& variant,
+                                          const cases::CaseParameters& p) {
+  std::vector<std::string> groups = spring_groups_of(variant);
+  if (variant == "three_tier" && p.mass_spring.inner_diagonals)
+    groups.emplace_back("tier23_diagonals");
+  if (p.mass_spring.volume_preservation && (variant == "three_tier" || variant == "tet_edges"))
+    groups.emplace_back(volume_group);
+  return groups;
+}
+
 void check_variant_names(const cases::CaseParameters& p) {
   const auto& known = known_variants();
   std::set<std::string> groups;
@@ -166,7 +179,8 @@ void check_variant_names(const cases::CaseParameters& p) {
     if (std::find(known.begin(), known.end(), v) == known.end())
       throw cases::InputError(p.file.string() + ": mass spring/variants: unknown variant '" + v +
                               "'");
-    groups.insert(spring_groups_of(v).begin(), spring_groups_of(v).end());
+    const std::vector<std::string> of_variant = spring_groups_of(v, p);
+    groups.insert(of_variant.begin(), of_variant.end());
   }
   if (p.mass_spring.volume_preservation) groups.insert(volume_group);
   for (const auto& [group, factor] : p.mass_spring.group_scales)
@@ -252,6 +266,11 @@ BuiltVariant build_variant(const std::string& name, const Problem& problem,
   try {
     ms::SpringNetwork network = build_network(name, problem, mesh);
     if (name == "tet_edges") variant.tetrahedra = mesh.tetrahedra;
+    if (problem.local_refinement) {
+      // three_tier copies the surface into its two inner tiers.
+      const int added = problem.local_refinement->added_vertices;
+      variant.refinement_added_nodes = name == "three_tier" ? 3 * added : added;
+    }
     variant.warnings = network.warnings;
     variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
     ms::MassSpringModel& model = *variant.model;

@@ -35,4 +35,19 @@ Eigen::VectorXd isotropic_network_stiffness(double youngs_modulus, double region
   return (6.0 * youngs_modulus * volume / count) * rest_lengths.array().square().inverse().matrix();
 }
 
+Eigen::VectorXd isotropic_network_stiffness(double youngs_modulus, double region_volume,
+                                            const Eigen::VectorXd& rest_lengths,
+                                            const Eigen::VectorXd& shares) {
+  check_modulus(youngs_modulus);
+  if (shares.size() != rest_lengths.size())
+    throw ModelError("isotropic network stiffness: " + std::to_string(shares.size()) +
+                     " volume shares for " + std::to_string(rest_lengths.size()) + " springs");
+  if (rest_lengths.size() == 0) return Eigen::VectorXd();
+  if (!shares.allFinite() || !(shares.minCoeff() > 0.0))
+    throw ModelError("isotropic network stiffness: volume shares must be finite and > 0");
+  const double volume = std::abs(region_volume);
+  return (6.0 * youngs_modulus * volume / shares.sum()) *
+         (shares.array() / rest_lengths.array().square()).matrix();
+}
+
 }  // namespace msfem::massspring

@@ -38,15 +38,21 @@ void add_nodes(SpringNetwork& network, const Eigen::MatrixX3d& positions,
 }
 
 void assign_network_stiffness(SpringNetwork& network, const std::vector<int>& groups,
-                              double youngs_modulus, double volume) {
+                              double youngs_modulus, double volume,
+                              const Eigen::VectorXd& node_weight) {
   std::vector<int> members;
   for (int s = 0; s < network.num_springs(); ++s)
     if (std::find(groups.begin(), groups.end(), network.spring_group[s]) != groups.end())
       members.push_back(s);
-  Eigen::VectorXd lengths(members.size());
-  for (std::size_t k = 0; k < members.size(); ++k)
+  Eigen::VectorXd lengths(members.size()), shares(members.size());
+  for (std::size_t k = 0; k < members.size(); ++k) {
     lengths[k] = network.rest_length[members[k]];
-  const Eigen::VectorXd k = isotropic_network_stiffness(youngs_modulus, volume, lengths);
+    // The finer end sets the share: a fine surface node's link to a coarse control point stands
+    // for the fine node's patch, not the control point's.
+    shares[k] = std::min(node_weight[network.springs(members[k], 0)],
+                         node_weight[network.springs(members[k], 1)]);
+  }
+  const Eigen::VectorXd k = isotropic_network_stiffness(youngs_modulus, volume, lengths, shares);
   for (std::size_t m = 0; m < members.size(); ++m)
     network.stiffness[members[m]] = k[m];
 }

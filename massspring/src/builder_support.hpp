@@ -18,9 +18,14 @@ void check_material(const Material& material);
 void add_nodes(SpringNetwork& network, const Eigen::MatrixX3d& positions,
                const std::string& group_name);
 
-/// Sets the stiffness of the springs of `groups` by the isotropic network rule over `volume`.
+/// Sets the stiffness of the springs of `groups` by the isotropic network rule over `volume`, each
+/// spring's share of it in proportion to min(w_a, w_b) over its two nodes. `node_weight` is a
+/// node's local measure of the region (its vertex area over the mean), so a refined patch is as
+/// stiff per volume as the coarse surface around it; on a uniform surface every share is equal
+/// (the seed's rule).
 void assign_network_stiffness(SpringNetwork& network, const std::vector<int>& groups,
-                              double youngs_modulus, double volume);
+                              double youngs_modulus, double volume,
+                              const Eigen::VectorXd& node_weight);
 
 /// Applies the material's damping to every spring and node.
 void assign_damping(SpringNetwork& network, const Material& material);

@@ -28,7 +28,8 @@ SpringNetwork build_single_layer(const Eigen::MatrixX3d& vertices,
   const double volume = std::abs(enclosed_volume(vertices, triangles));
   const Eigen::VectorXd areas = vertex_areas(vertices, triangles);
   network.masses = options.material.density * volume * areas / areas.sum();
-  detail::assign_network_stiffness(network, {edges}, options.material.youngs_modulus, volume);
+  detail::assign_network_stiffness(network, {edges}, options.material.youngs_modulus, volume,
+                                   areas / areas.mean());
 
   if (options.anchor_to_rest) {
     Eigen::VectorXd summed = Eigen::VectorXd::Zero(nv);

@@ -31,7 +31,7 @@ SpringNetwork build_skeleton(const Eigen::MatrixX3d& vertices, const Eigen::Matr
 
   const int nv = static_cast<int>(vertices.rows());
   const int nc = static_cast<int>(control_vertices.rows());
-  const Eigen::Vector3d centroid = vertex_centroid(vertices);
+  const Eigen::Vector3d centroid = options.center.value_or(vertex_centroid(vertices));
   const Eigen::MatrixX3d control =
       ((control_vertices.rowwise() - centroid.transpose()) * options.control_scale).rowwise() +
       centroid.transpose();
@@ -59,8 +59,10 @@ SpringNetwork build_skeleton(const Eigen::MatrixX3d& vertices, const Eigen::Matr
   const Eigen::VectorXd control_areas = vertex_areas(control, control_triangles);
   network.masses.head(nv) = 0.5 * rho * volume * surface_areas / surface_areas.sum();
   network.masses.tail(nc) = 0.5 * rho * volume * control_areas / control_areas.sum();
+  Eigen::VectorXd weight(nv + nc);
+  weight << surface_areas / surface_areas.mean(), control_areas / control_areas.mean();
   detail::assign_network_stiffness(network, {surface_group, skeleton_group, link_group},
-                                   options.material.youngs_modulus, volume);
+                                   options.material.youngs_modulus, volume, weight);
   detail::assign_damping(network, options.material);
 
   for (int i = 0; i < nv; ++i)

@@ -245,6 +245,21 @@ double reference_norm(const MassSpringModel& model, const FreeDofs& dofs) {
   return std::max(std::sqrt(load_norm_squared), initial);
 }
 
+// The force residual round-off leaves: each force is a sum of k (|x_a − x_b| − l) terms whose
+// positions carry a relative error ε, so |f| cannot be resolved below about ε k_max |x| per
+// coordinate. A target under it is met by no iterate, and Newton then wanders (along an
+// indefinite tangent, or with steps the line search cannot judge) instead of stopping.
+double roundoff_floor(const MassSpringModel& model, const FreeDofs& dofs,
+                      const Eigen::VectorXd& x) {
+  double x_scale = 0.0;
+  for (int k : dofs.full_index)
+    x_scale = std::max(x_scale, std::abs(x[k]));
+  const double k_max =
+      free_stiffness(model, x, dofs, Linearisation::definite).diagonal().cwiseAbs().maxCoeff();
+  return 16.0 * std::numeric_limits<double>::epsilon() * k_max * x_scale *
+         std::sqrt(double(dofs.size()));
+}
+
 }  // namespace
 
 StaticResult solve_static(const MassSpringModel& model, const StaticOptions& options,
@@ -267,6 +282,7 @@ StaticResult solve_static(const MassSpringModel& model, const StaticOptions& opt
     return result;
   }
   const double target = options.tolerance * result.reference_norm;
+  const double floor = roundoff_floor(model, dofs, result.x);
 
   DirectionFinder directions(model, dofs, options);
   const detail::NodeRelaxation relaxation(model);
@@ -316,6 +332,10 @@ StaticResult solve_static(const MassSpringModel& model, const StaticOptions& opt
     record.residual_norm = result.residual_norm;
     record.step_length = step.alpha;
     result.history.push_back(record);
+    if (result.residual_norm > target && result.residual_norm <= floor) {
+      result.converged_at_roundoff = true;
+      break;
+    }
   }
   result.factorizations = directions.factorizations();
   result.converged = result.residual_norm <= target || result.converged_at_roundoff;

@@ -89,7 +89,7 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   check_options(options);
 
   const int nv = static_cast<int>(vertices.rows());
-  const Eigen::Vector3d centroid = vertex_centroid(vertices);
+  const Eigen::Vector3d centroid = options.center.value_or(vertex_centroid(vertices));
   const Eigen::MatrixX3d normals = vertex_normals(vertices, triangles);
   const double mean_radius = (vertices.rowwise() - centroid.transpose()).rowwise().norm().mean();
   const Eigen::MatrixX3d tier2 = inner_tier(vertices, normals, centroid, mean_radius, options,
@@ -125,6 +125,15 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   const int g12 = add_springs(network, diagonals, "tier12_diagonals");
   const int r12 = add_springs(network, radial12, "tier12_radial");
   const int r23 = add_springs(network, radial23, "tier23_radial");
+  std::vector<int> shell23_groups = {r23};
+  if (options.tier23_diagonals) {
+    std::vector<std::array<int, 2>> inner;
+    for (const auto& [a, b] : edges) {
+      inner.push_back({nv + a, 2 * nv + b});
+      inner.push_back({nv + b, 2 * nv + a});
+    }
+    shell23_groups.push_back(add_springs(network, inner, "tier23_diagonals"));
+  }
 
   // Masses lumped from volume: half of each shell to each of its two tiers, by vertex area; the
   // core inside tier 3 to tier 3. Volumes of inverted (non-nested) tiers are clamped at zero.
@@ -151,12 +160,15 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   }
 
   const double modulus = options.material.youngs_modulus;
+  // Every tier's node i stands for the same patch of the shells: tier 1's vertex area.
+  const Eigen::VectorXd area = vertex_areas(vertices, triangles);
+  const Eigen::VectorXd weight = (area / area.mean()).replicate(3, 1);
   detail::assign_network_stiffness(
       network, {g1, g2, g12, r12}, modulus,
-      stiffness_volume(network, vertices, tier2, triangles, shell12, "tier 1 and tier 2"));
+      stiffness_volume(network, vertices, tier2, triangles, shell12, "tier 1 and tier 2"), weight);
   detail::assign_network_stiffness(
-      network, {r23}, modulus,
-      stiffness_volume(network, tier2, tier3, triangles, shell23, "tier 2 and tier 3"));
+      network, shell23_groups, modulus,
+      stiffness_volume(network, tier2, tier3, triangles, shell23, "tier 2 and tier 3"), weight);
   detail::assign_damping(network, options.material);
 
   for (int i = 0; i < nv; ++i) {

@@ -331,6 +331,46 @@ TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
   EXPECT_NE(b["fem"]["cache_key"], fem["cache_key"]);
 }
 
+// The local point distribution refines the one surface both models are built on: the case's
+// vertices first, every variant following it, and the counts in summary.json.
+TEST(CliRun, ContactRefinementRefinesTheSurfaceEveryModelIsBuiltOn) {
+  TemporaryDirectory tmp;
+  const auto r = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" +
+                           " --set \"mass spring/variants=three_tier,single_layer\"" +
+                           " --set \"mass spring/contact refinement/enabled=true\"" + " --out " +
+                           (tmp / "refined").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_text(tmp / "refined" / "summary.json"));
+  const auto& refinement = j["contact_refinement"];
+  ASSERT_TRUE(refinement.is_object()) << j.dump();
+  // Defaults: twice the tool radius, a third of it.
+  EXPECT_DOUBLE_EQ(refinement["radius_m"].get<double>(), 0.02);
+  EXPECT_DOUBLE_EQ(refinement["edge_length_m"].get<double>(), 0.01 / 3);
+  const int added = refinement["added_surface_vertices"].get<int>();
+  const int icosphere_level_2 = 162;
+  EXPECT_EQ(j["surface"]["vertices"].get<int>(), icosphere_level_2 + added);
+  // The cap within 2 cm holds at least its area over a triangle of edge 3.3 mm, halved, vertices
+  // (~130); triangles reaching into it from outside (edges of 15 mm on the level-2 sphere) and
+  // bisected edges shorter than the limit add more, but not a whole sphere's worth.
+  EXPECT_GT(added, 130);
+  EXPECT_LT(added, 2000);
+  for (const auto& v : j["variants"]) {
+    const int copies = v["name"] == "three_tier" ? 3 : 1;
+    EXPECT_EQ(v["contact_refinement_added_nodes"].get<int>(), copies * added) << v["name"];
+    EXPECT_EQ(v["nodes"].get<int>(), copies * (icosphere_level_2 + added)) << v["name"];
+  }
+
+  // Without a tool there is nothing to refine around: a clear error, nothing written.
+  const auto no_tool = run_msfem(
+      "run " + small_case + " --quiet --no-timing --no-cache" +
+      " --set \"mass spring/contact refinement/enabled=true\"" + " --set loads/tool/enabled=false" +
+      " --set \"loads/gravity=0,0,-9.81\" --out " + (tmp / "no_tool").string());
+  EXPECT_EQ(no_tool.exit_code, 2) << no_tool.err;
+  EXPECT_NE(no_tool.err.find("mass spring/contact refinement/enabled"), std::string::npos)
+      << no_tool.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "no_tool"));
+}
+
 TEST(CliParams, PrintsTheWholeLanguage) {
   const auto r = run_msfem("params");
   ASSERT_EQ(r.exit_code, 0);

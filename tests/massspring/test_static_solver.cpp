@@ -152,7 +152,8 @@ TEST(StaticSolverAcceleration, WarmStartAfterAStiffnessChangeMatchesColdStart) {
 
 TEST(StaticSolverAcceleration, ToleranceBelowRoundOffStopsAtTheFloor) {
   // |f| cannot fall below the cancellation in the spring forces (~1e-16 × k × |x| per spring):
-  // asked for less, Newton stops once its step no longer moves x, instead of running on.
+  // asked for less, Newton stops once its step no longer moves x or |f| is under that floor,
+  // instead of running on.
   const MassSpringModel model = indented_sphere();
   const StaticResult usual = solve_static(model);
   StaticOptions strict;

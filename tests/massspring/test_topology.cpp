@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -114,6 +116,119 @@ TEST(ThreeTier, FoldedInnerTierKeepsItsShellStiffness) {
   EXPECT_NEAR(network.masses.sum() / body, 1.0, 1e-9);
 }
 
+// Splits every triangle whose centroid lies within `radius` of `point` at that centroid (a
+// conforming local refinement that keeps the surface's shape).
+testing::TriangleMesh refine_at(testing::TriangleMesh mesh, const Eigen::Vector3d& point,
+                                double radius) {
+  std::vector<Eigen::Vector3i> triangles;
+  std::vector<Eigen::RowVector3d> added;
+  const int nv = int(mesh.vertices.rows());
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    const Eigen::Vector3i f = mesh.triangles.row(t);
+    const Eigen::RowVector3d c =
+        (mesh.vertices.row(f[0]) + mesh.vertices.row(f[1]) + mesh.vertices.row(f[2])) / 3.0;
+    if ((c.transpose() - point).norm() > radius) {
+      triangles.push_back(f);
+      continue;
+    }
+    const int m = nv + int(added.size());
+    added.push_back(c);
+    triangles.push_back({f[0], f[1], m});
+    triangles.push_back({f[1], f[2], m});
+    triangles.push_back({f[2], f[0], m});
+  }
+  mesh.vertices.conservativeResize(nv + Eigen::Index(added.size()), 3);
+  for (std::size_t k = 0; k < added.size(); ++k)
+    mesh.vertices.row(nv + Eigen::Index(k)) = added[k];
+  mesh.triangles.resize(Eigen::Index(triangles.size()), 3);
+  for (std::size_t k = 0; k < triangles.size(); ++k)
+    mesh.triangles.row(Eigen::Index(k)) = triangles[k].transpose();
+  return mesh;
+}
+
+// Σ k l² of a group's springs whose first node belongs to a surface vertex in the cap (node i of
+// every tier to vertex i mod V), per unit of the cap's area: the network's modulus there
+// (Σ k l² = 6 E V for the isotropic rule).
+double modulus_density(const SpringNetwork& n, const testing::TriangleMesh& mesh,
+                       const std::string& group, const Eigen::Vector3d& pole, double cap) {
+  const int g = int(std::find(n.spring_group_names.begin(), n.spring_group_names.end(), group) -
+                    n.spring_group_names.begin());
+  const Eigen::VectorXd areas = vertex_areas(mesh.vertices, mesh.triangles);
+  double sum = 0.0, area = 0.0;
+  for (int s = 0; s < n.num_springs(); ++s) {
+    const Eigen::Index vertex = n.springs(s, 0) % mesh.vertices.rows();
+    if (n.spring_group[s] != g || (mesh.vertices.row(vertex).transpose() - pole).norm() > cap)
+      continue;
+    sum += n.stiffness[s] * n.rest_length[s] * n.rest_length[s];
+  }
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+    if ((mesh.vertices.row(v).transpose() - pole).norm() <= cap) area += areas[v];
+  return sum / area;
+}
+
+// Each spring's share of its shell's volume follows the vertex areas at its ends: a patch with
+// nine times the triangles is as stiff per area as before (equal shares made it 7.7x stiffer).
+TEST(ThreeTier, ALocallyRefinedPatchKeepsItsModulus) {
+  const auto coarse = icosphere(3, 0.05);
+  const Eigen::Vector3d pole(0, 0, 0.05);
+  const auto fine = refine_at(refine_at(coarse, pole, 0.015), pole, 0.015);
+  ASSERT_GT(fine.vertices.rows(), coarse.vertices.rows() + 60);
+  const SpringNetwork a = build_three_tier(coarse.vertices, coarse.triangles);
+  const SpringNetwork b = build_three_tier(fine.vertices, fine.triangles);
+  for (const char* group : {"tier12_radial", "tier23_radial"}) {
+    const double ratio =
+        modulus_density(b, fine, group, pole, 0.01) / modulus_density(a, coarse, group, pole, 0.01);
+    EXPECT_NEAR(ratio, 1.0, 0.1) << group;
+  }
+  // The surface's edges: every fine edge's share is its smaller end's area.
+  const double edges = modulus_density(b, fine, "tier1_edges", pole, 0.01) /
+                       modulus_density(a, coarse, "tier1_edges", pole, 0.01);
+  EXPECT_GT(edges, 0.5);
+  EXPECT_LT(edges, 1.5);
+}
+
+// Σ k (n·(v_a − v_b))²: the network's stiffness against the mode v at rest (springs untensioned).
+double mode_stiffness(const SpringNetwork& n, const std::vector<Eigen::Vector3d>& v) {
+  double sum = 0.0;
+  for (int s = 0; s < n.num_springs(); ++s) {
+    const int a = n.springs(s, 0), b = n.springs(s, 1);
+    const Eigen::Vector3d axis =
+        (n.rest_positions.row(b) - n.rest_positions.row(a)).transpose().normalized();
+    const double stretch = axis.dot(v[std::size_t(b)] - v[std::size_t(a)]);
+    sum += n.stiffness[s] * stretch * stretch;
+  }
+  return sum;
+}
+
+// The seed's tier 2 hangs on the fixed tier 3 by radial springs only: turning tiers 1 and 2 as a
+// rigid body about the centre stretches no spring (to first order). The inner diagonals resist it.
+TEST(ThreeTier, InnerDiagonalsResistTheOuterShellTurningAboutTheCore) {
+  const auto mesh = icosphere(3, 0.05);
+  ThreeTierOptions with;
+  with.tier23_diagonals = true;
+  const SpringNetwork seed = build_three_tier(mesh.vertices, mesh.triangles);
+  const SpringNetwork braced = build_three_tier(mesh.vertices, mesh.triangles, with);
+  EXPECT_EQ(seed.num_springs(), 8964);
+  EXPECT_EQ(braced.num_springs(), 8964 + 2 * 1920);  // two per edge
+  const int nv = 642;
+  auto turn = [&](const SpringNetwork& n) {
+    std::vector<Eigen::Vector3d> v(std::size_t(n.num_nodes()), Eigen::Vector3d::Zero());
+    for (int i = 0; i < 2 * nv; ++i)  // tiers 1 and 2 about the x axis, tier 3 held
+      v[std::size_t(i)] = Eigen::Vector3d::UnitX().cross(n.rest_positions.row(i).transpose());
+    return v;
+  };
+  auto push = [&](const SpringNetwork& n) {  // tiers 1 and 2 pushed along z instead
+    std::vector<Eigen::Vector3d> v(std::size_t(n.num_nodes()), Eigen::Vector3d::Zero());
+    for (int i = 0; i < 2 * nv; ++i)
+      v[std::size_t(i)] = 0.05 * Eigen::Vector3d::UnitZ();  // the same size as the turn's
+    return v;
+  };
+  EXPECT_LT(mode_stiffness(seed, turn(seed)), 1e-12 * mode_stiffness(seed, push(seed)));
+  // The diagonals lie within ~20° of the radial springs (a 17 mm shell, 6 mm edges): a turn meets
+  // a few per cent of the stiffness of a push.
+  EXPECT_GT(mode_stiffness(braced, turn(braced)), 0.01 * mode_stiffness(braced, push(braced)));
+}
+
 TEST(SingleLayer, SurfaceEdgesAndAnchors) {
   const auto mesh = icosphere(3, 0.05);
   const SpringNetwork network = build_single_layer(mesh.vertices, mesh.triangles);
@@ -218,6 +333,19 @@ TEST(AnalyticStiffness, Formulas) {
   lengths << 0.01, 0.02;
   const Eigen::VectorXd k = isotropic_network_stiffness(3000.0, 1e-6, lengths);
   EXPECT_NEAR((k.array() * lengths.array().square()).sum(), 6.0 * 3000.0 * 1e-6, 1e-15);
+  // Shares: Σ k l² still 6 E V, split 1 : 3; equal shares are the rule above.
+  Eigen::VectorXd shares(2);
+  shares << 1.0, 3.0;
+  const Eigen::VectorXd w = isotropic_network_stiffness(3000.0, 1e-6, lengths, shares);
+  EXPECT_NEAR(w[0] * 1e-4, 0.25 * 6.0 * 3000.0 * 1e-6, 1e-15);
+  EXPECT_NEAR(w[1] * 4e-4, 0.75 * 6.0 * 3000.0 * 1e-6, 1e-15);
+  const Eigen::VectorXd equal =
+      isotropic_network_stiffness(3000.0, 1e-6, lengths, Eigen::VectorXd::Constant(2, 7.0));
+  EXPECT_NEAR((equal - k).norm(), 0.0, 1e-12 * k.norm());
+  shares[1] = 0.0;
+  EXPECT_THROW(isotropic_network_stiffness(3000.0, 1e-6, lengths, shares), ModelError);
+  EXPECT_THROW(isotropic_network_stiffness(3000.0, 1e-6, lengths, Eigen::VectorXd::Ones(3)),
+               ModelError);
 }
 
 }  // namespace

@@ -89,8 +89,19 @@ struct MassSpringParameters {
   double middle_tier_scale = 1.2;
   double inner_tier_scale = 2.0;
   std::string inner_tiers = "scaled";  ///< scaled | offset (along the inward normal)
+  bool inner_diagonals = false;        ///< tier 2 to tier 3 crossing diagonals (not the seed's)
   int skeleton_control_points = 0;     ///< 0: a tenth of the surface vertices, at least 20
   double skeleton_draw_factor = 0.45;  ///< control points drawn toward the centroid by this factor
+  /// A local point distribution at the tool, after the layered brain paper's: the case's surface
+  /// is refined around each tool before any model is built, so every variant (and the FEM, which
+  /// keeps the refined surface's vertices) follows it. Off by default: docs/harness.md says what
+  /// it does to each variant.
+  struct ContactRefinement {
+    bool enabled = false;
+    double radius_m = 0.0;  ///< around each tool's contact point; 0: 2 × the tool radius
+    double edge_m = 0.0;    ///< longest edge there; 0: the tool radius / 3
+  };
+  ContactRefinement contact_refinement;
 };
 
 struct FemParameters {

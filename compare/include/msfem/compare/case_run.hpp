@@ -59,6 +59,7 @@ struct ToolLoadVariant {
 /// The variant at the run's own (first) tool position, with what only that load gets.
 struct VariantResult : ToolLoadVariant {
   int nodes = 0, springs = 0;
+  std::optional<int> refinement_added_nodes;  ///< BuiltVariant's
   Timing timing;
   int newton_iterations = 0;
   nlohmann::json parameters;  ///< group stiffness, damping, masses as used

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,13 @@ struct ToolPlacement {
   }
 };
 
+/// The local point distribution at the tools (mass spring/contact refinement), once applied.
+struct LocalRefinement {
+  double radius_m = 0.0;   ///< around each tool's contact point
+  double edge_m = 0.0;     ///< longest surface edge inside
+  int added_vertices = 0;  ///< surface vertices added (appended after the case's own)
+};
+
 struct Problem {
   cases::CaseParameters parameters;
   cases::Surface surface;  ///< outward, closed, manifold, metres
@@ -35,6 +43,9 @@ struct Problem {
   /// The fixed region as a predicate on positions (the same for both models).
   std::function<bool(const Eigen::Vector3d&)> fixed_region;
   std::vector<ToolPlacement> tools;  ///< one per tool direction (empty when the tool is off)
+  /// Set when the surface was refined around the tools; the centroid and the fixed region are
+  /// those of the surface before (refinement keeps its shape, but not its vertex centroid).
+  std::optional<LocalRefinement> local_refinement;
 };
 
 /// Loads and checks the case's surface (generate or read, simplify, smooth, orient) and places its

@@ -20,6 +20,10 @@ const std::vector<std::string>& known_variants();
 /// The spring groups each variant's builder makes (tests check the list against the built
 /// networks), for checking a case's names before anything is solved.
 const std::vector<std::string>& spring_groups_of(const std::string& variant);
+/// The same for the variant as the case builds it: with three_tier's `tier23_diagonals` (mass
+/// spring/three tier/inner diagonals) and the `volume` group (mass spring/volume preservation).
+std::vector<std::string> spring_groups_of(const std::string& variant,
+                                          const cases::CaseParameters& p);
 
 /// Throws cases::InputError naming the case file and key for a variant msfem does not have, and
 /// for a `mass spring/group scales` group that none of the case's variants has (or `volume`
@@ -47,6 +51,10 @@ struct BuiltVariant {
   /// The case's surface vertices are the first this many surface nodes (tet_edges on the FEM's
   /// mesh refined at the tool has more; only these are compared).
   Eigen::Index case_surface_vertices = 0;
+  /// Nodes the local point distribution at the tools added: Problem::local_refinement's surface
+  /// vertices (three_tier: in all three tiers; tet_edges: on the surface, the
+  /// mesher grading the interior to them); unset without one.
+  std::optional<int> refinement_added_nodes;
   /// The volume elements whose edges are the springs (tet_edges; empty for the other variants),
   /// node indices of the model: a spring network has no resistance to their inversion, so runs
   /// count the inverted ones.

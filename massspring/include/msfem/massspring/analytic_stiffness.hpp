@@ -24,4 +24,13 @@ double van_gelder_stiffness(double youngs_modulus, double summed_tet_volume, dou
 Eigen::VectorXd isotropic_network_stiffness(double youngs_modulus, double region_volume,
                                             const Eigen::VectorXd& rest_lengths);
 
+/// The same rule with spring s's share of V in proportion to shares_s (> 0): k_s =
+/// 6 E V shares_s / (Σ shares · l_s²). Equal shares give the form above; shares that follow the
+/// local node spacing keep the modulus of a locally refined network what it is elsewhere (with
+/// equal shares, a region with four times the springs per volume would be four times as stiff).
+/// Throws ModelError for a share that is not finite and > 0, or sizes that differ.
+Eigen::VectorXd isotropic_network_stiffness(double youngs_modulus, double region_volume,
+                                            const Eigen::VectorXd& rest_lengths,
+                                            const Eigen::VectorXd& shares);
+
 }  // namespace msfem::massspring

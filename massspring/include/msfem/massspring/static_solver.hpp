@@ -82,7 +82,8 @@ struct StaticResult {
   bool converged = false;
   /// Converged because the Newton step fell below the resolution of doubles at x while |f| was
   /// still above the tolerance: |f| is then at its round-off floor (cancellation in the spring
-  /// forces), which on the brain lies near 1e-11 × the reference.
+  /// forces), which on the brain lies near 1e-11 × the reference; or because |f| fell below that
+  /// floor, estimated as 16 ε k_max |x|_max √n (k_max the largest diagonal stiffness).
   bool converged_at_roundoff = false;
   int factorizations = 0;                ///< LDLT factorisations, the dominant cost
   int preconditioned_iterations = 0;     ///< CG iterations with a reused factorisation

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "msfem/massspring/spring_network.hpp"
 
@@ -34,6 +35,15 @@ struct ThreeTierOptions {
   /// An inner-tier node outside the outer surface (scaling a concave surface can do that) is always
   /// reported in SpringNetwork::warnings; with this set it throws ModelError instead.
   bool reject_inner_tier_outside = false;
+  /// The point the tiers are scaled about (c above); unset: the vertex centroid. A surface refined
+  /// near a tool has its vertex centroid pulled toward the tool, so its caller passes the
+  /// unrefined surface's to keep tier 3 where the support expects it.
+  std::optional<Eigen::Vector3d> center;
+  /// Crossing diagonals between tier 2 and tier 3 as between tiers 1 and 2 (group
+  /// "tier23_diagonals"). The seed links tier 2 to the fixed tier 3 by radial springs only, which
+  /// resist a rigid turn of the outer shell about the core at second order only: a lateral push
+  /// turns it freely.
+  bool tier23_diagonals = false;
   Material material;
 };
 
@@ -42,7 +52,8 @@ struct ThreeTierOptions {
 /// "tier23_radial". Node groups: "tier1", "tier2", "tier3".
 /// Masses: density × volume; each shell between tiers is lumped half to each bounding tier,
 /// spread by vertex area, and the core inside tier 3 goes to tier 3. Stiffness: the isotropic
-/// network rule (analytic_stiffness.hpp) per shell.
+/// network rule (analytic_stiffness.hpp) per shell, each spring's share of the shell's volume
+/// following the vertex areas at its ends (so a locally refined surface is not stiffer there).
 SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
                                const ThreeTierOptions& options = {});
 
@@ -69,6 +80,8 @@ struct SkeletonOptions {
   double control_scale = 0.5;
   int links_per_vertex = 4;
   bool fix_control_points = false;
+  /// The point control points are drawn toward (c above); unset: the vertex centroid.
+  std::optional<Eigen::Vector3d> center;
   Material material;
 };
 SpringNetwork build_skeleton(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
