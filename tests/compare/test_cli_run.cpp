@@ -371,6 +371,58 @@ TEST(CliRun, ContactRefinementRefinesTheSurfaceEveryModelIsBuiltOn) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "no_tool"));
 }
 
+// A U of two towers 2 cm wide, extruded 2 cm, with a middle layer of vertices (listed first): the
+// left tower's top rises toward the gap, so its highest vertex is the middle of its inner top
+// edge, and its normal leans over the gap toward the right tower.
+std::string write_u_shape(const std::filesystem::path& file) {
+  const double p[10][2] = {{0, 0},   {1, 0},   {2, 0},   {3, 0},   {3, 1},
+                           {2, 1.1}, {2, 0.3}, {1, 0.3}, {1, 1.2}, {0, 1}};
+  const int cap[8][3] = {{0, 1, 7}, {0, 7, 8}, {0, 8, 9}, {1, 2, 6},
+                         {1, 6, 7}, {3, 4, 5}, {3, 5, 6}, {3, 6, 2}};
+  std::ofstream out(file);
+  for (double y : {0.5, 0.0, 1.0})  // OBJ ids: middle 1-10, front 11-20, back 21-30
+    for (const auto& v : p)
+      out << "v " << 0.02 * v[0] << " " << 0.02 * y << " " << 0.02 * v[1] << "\n";
+  for (const auto& t : cap) {  // the back cap turned over (msfem orients the whole anyway)
+    out << "f " << t[0] + 11 << " " << t[1] + 11 << " " << t[2] + 11 << "\n";
+    out << "f " << t[0] + 21 << " " << t[2] + 21 << " " << t[1] + 21 << "\n";
+  }
+  for (const auto& [a, b] : {std::pair{10, 0}, std::pair{0, 20}})
+    for (int i = 0; i < 10; ++i) {
+      const int j = (i + 1) % 10;
+      out << "f " << i + a + 1 << " " << i + b + 1 << " " << j + b + 1 << "\n";
+      out << "f " << i + a + 1 << " " << j + b + 1 << " " << j + a + 1 << "\n";
+    }
+  return file.string();
+}
+
+// A contact tool must start outside the body (a sphere already inside would be pushed out):
+// refused before any meshing, naming
+// the key, with nothing written.
+TEST(CliRun, ContactToolStartingInsideAConcaveSurfaceIsRefused) {
+  TemporaryDirectory tmp;
+  const std::string u = write_u_shape(tmp / "u.obj");
+  const std::string common = "run " + small_case + " --quiet --no-timing --no-cache" +
+                             " --set loads/tool/mode=contact --set geometry/source=" + u +
+                             " --set \"support/fixed region=half space\"" +
+                             " --set \"support/half space point=0,0,0.002\"";
+  // A 3 cm sphere resting on the left tower's inner edge reaches over the gap into the right
+  // tower (2 mm lower, 2 cm away): its centre is 2.7 cm from it.
+  const auto inside = run_msfem(common + " --set loads/tool/radius=0.03" +
+                                " --set loads/tool/depth=0.001 --set \"loads/tool/curve depths=\"" +
+                                " --out " + (tmp / "inside").string());
+  EXPECT_EQ(inside.exit_code, 2) << inside.err;
+  EXPECT_NE(inside.err.find("loads/tool"), std::string::npos) << inside.err;
+  EXPECT_NE(inside.err.find("starts inside the body"), std::string::npos) << inside.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "inside"));
+  // A 2 mm sphere there is clear of the right tower and presses the corner.
+  const auto small_tool =
+      run_msfem(common + " --set loads/tool/radius=0.002" +
+                " --set loads/tool/depth=0.001 --set \"loads/tool/curve depths=\"" +
+                " --set \"mass spring/variants=single_layer\" --out " + (tmp / "small").string());
+  EXPECT_EQ(small_tool.exit_code, 0) << small_tool.err;
+}
+
 TEST(CliParams, PrintsTheWholeLanguage) {
   const auto r = run_msfem("params");
   ASSERT_EQ(r.exit_code, 0);
