@@ -63,11 +63,25 @@ struct LoadModels {
   std::vector<std::unique_ptr<LinearisedStatics>> linear;  ///< the fast path, when asked for
 };
 
+// The surface nodes a frictionless tool pushes at x (those its contact force reaches).
+int nodes_in_contact(const BuiltVariant& variant, const Eigen::VectorXd& x) {
+  const auto* contact = variant.model->contact();
+  if (!contact || x.size() == 0) return 0;
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
+  contact->add_force(x, Eigen::VectorXd::Zero(x.size()), f);
+  int count = 0;
+  for (Eigen::Index i = 0; i < x.size() / 3; ++i)
+    count += f.segment<3>(3 * i).squaredNorm() > 0.0;
+  return count;
+}
+
 LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d& displacement,
-                          const Eigen::Vector3d& force, const BuiltVariant& variant) {
+                          const Eigen::Vector3d& force, const BuiltVariant& variant,
+                          const Eigen::VectorXd& x = {}) {
   LoadErrors e;
   e.load = reference.load.label();
-  e.tool_patch_nodes = static_cast<int>(variant.tool_patch.size());
+  e.tool_patch_nodes = variant.tool_patch.empty() ? nodes_in_contact(variant, x)
+                                                  : static_cast<int>(variant.tool_patch.size());
   // tet_edges on the FEM's tool-refined mesh has more surface nodes; the case's come first.
   const Eigen::Index n = reference.surface_displacement.rows();
   if (displacement.rows() < n)
@@ -108,7 +122,7 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadRefere
     const StaticSolution s = solve_variant_static(m.variants[i], m.x[i]);
     m.x[i] = s.x;
     errors.push_back(
-        errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i]));
+        errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i], s.x));
   }
   return errors;
 }
@@ -144,7 +158,7 @@ LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference,
   set_tool_depth(variant, reference.tool);
   const StaticSolution s = solve_variant_static(variant, x);
   x = s.x;
-  return errors_against(reference, s.surface_displacement, s.tool_force, variant);
+  return errors_against(reference, s.surface_displacement, s.tool_force, variant, s.x);
 }
 
 LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference) {

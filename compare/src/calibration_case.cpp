@@ -291,12 +291,14 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   const std::vector<cases::ToolLoad> train = request.train.value_or(defaults.train);
   const std::vector<cases::ToolLoad> test = request.test.value_or(defaults.test);
   check_loads(parameters, train, test);
-  // The fit's linearised statics hold the tool as a prescribed patch; a frictionless tool would be
-  // fitted against loads it does not apply.
-  if (parameters.loads.tool.mode == cases::ToolParameters::Mode::contact)
+  // The linearised statics hold the tool as a prescribed patch; a frictionless tool would be
+  // fitted against loads it does not apply. The nonlinear fit presses by contact as msfem run does.
+  if (parameters.loads.tool.mode == cases::ToolParameters::Mode::contact &&
+      defaults.model == "linear")
     throw cases::InputError(parameters.file.string() +
-                            ": loads/tool/mode = contact: msfem calibrate fits the bonded patch "
-                            "only; set mode = bonded to calibrate");
+                            ": calibration/model = linear holds the tool as a bonded patch, but "
+                            "loads/tool/mode = contact: use calibration/model = nonlinear (the "
+                            "default) to calibrate in contact");
   check_variant_names(parameters);
   c.options.groups = request.groups.value_or(defaults.groups);
   check_fit_groups(parameters, c.variant, c.options.groups);

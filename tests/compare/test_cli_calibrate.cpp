@@ -111,6 +111,28 @@ TEST(CliCalibrate, TheFittedVolumeModulusIsWhatCalibratedPrmBuilds) {
   EXPECT_TRUE(found);
 }
 
+// In contact mode the fit presses both models by frictionless contact, as msfem run does: the
+// tool pushes more than the one node under it, the objective falls, and the linearised model
+// (which holds a bonded patch) is refused.
+TEST(CliCalibrate, ContactModeFitsAgainstTheFrictionlessReference) {
+  TemporaryDirectory tmp;
+  const std::string contact = " --set loads/tool/mode=contact" +
+                              std::string(" --set \"mass spring/three tier/inner diagonals=true\"");
+  const auto r = run_msfem("calibrate " + small_case + " --quiet --json" + contact + " --out " +
+                           (tmp / "cal").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_LT(j["after"]["objective"].get<double>(), 0.5 * j["before"]["objective"].get<double>());
+  for (const auto& e : j["after"]["train"])
+    EXPECT_GT(e["tool_patch_nodes"].get<int>(), 1) << e["load"];
+  const auto linear =
+      run_msfem("calibrate " + small_case + " --quiet" + contact +
+                " --set calibration/model=linear --out " + (tmp / "linear").string());
+  EXPECT_EQ(linear.exit_code, 2) << linear.err;
+  EXPECT_NE(linear.err.find("calibration/model = linear"), std::string::npos) << linear.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "linear"));
+}
+
 TEST(CliCalibrate, BadInputIsOneLineAndLeavesNoResultFolder) {
   TemporaryDirectory tmp;
   const std::vector<std::pair<std::string, std::string>> cases = {

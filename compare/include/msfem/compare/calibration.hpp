@@ -38,7 +38,8 @@ struct LoadErrors {
   double mean_error_over_max_disp = 0.0;
   double reaction_force_rel_error = 0.0;
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
-  /// Surface nodes the tool holds in the spring model at this load. One node's force grows about
+  /// Surface nodes the tool holds (bonded) or pushes (contact) in the spring model at this load.
+  /// One node's force grows about
   /// linearly with depth while the FEM's resolved contact grows faster: no stiffness fits every
   /// depth then (docs/calibration.md, "When the surface cannot resolve the tool").
   int tool_patch_nodes = 0;
