@@ -61,10 +61,7 @@ void check_loads(const cases::CaseParameters& p, const std::vector<cases::ToolLo
 // Before any solve: every group to fit is one the variant has.
 void check_fit_groups(const cases::CaseParameters& p, const std::string& variant,
                       const std::vector<std::string>& groups) {
-  std::vector<std::string> known = spring_groups_of(variant, p);
-  if (p.mass_spring.volume_preservation &&
-      std::find(known.begin(), known.end(), volume_group) == known.end())
-    known.emplace_back(volume_group);
+  const std::vector<std::string> known = spring_groups_of(variant, p);
   for (const auto& g : groups)
     if (std::find(known.begin(), known.end(), g) == known.end()) {
       std::string list;

@@ -167,8 +167,7 @@ std::vector<std::string> spring_groups_of(const std::string& variant,
   std::vector<std::string> groups = spring_groups_of(variant);
   if (variant == "three_tier" && p.mass_spring.inner_diagonals)
     groups.emplace_back("tier23_diagonals");
-  if (p.mass_spring.volume_preservation && (variant == "three_tier" || variant == "tet_edges"))
-    groups.emplace_back(volume_group);
+  if (p.mass_spring.volume_preservation) groups.emplace_back(volume_group);
   return groups;
 }
 
@@ -182,7 +181,6 @@ void check_variant_names(const cases::CaseParameters& p) {
     const std::vector<std::string> of_variant = spring_groups_of(v, p);
     groups.insert(of_variant.begin(), of_variant.end());
   }
-  if (p.mass_spring.volume_preservation) groups.insert(volume_group);
   for (const auto& [group, factor] : p.mass_spring.group_scales)
     if (!groups.count(group)) {
       std::string list;

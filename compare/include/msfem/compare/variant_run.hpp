@@ -20,8 +20,9 @@ const std::vector<std::string>& known_variants();
 /// The spring groups each variant's builder makes (tests check the list against the built
 /// networks), for checking a case's names before anything is solved.
 const std::vector<std::string>& spring_groups_of(const std::string& variant);
-/// The same for the variant as the case builds it: with three_tier's `tier23_diagonals` (mass
-/// spring/three tier/inner diagonals) and the `volume` group (mass spring/volume preservation).
+/// The same as the case names them: with three_tier's `tier23_diagonals` (mass spring/three
+/// tier/inner diagonals) and, under mass spring/volume preservation, `volume` (a variant without
+/// volume elements is told so when it is fitted).
 std::vector<std::string> spring_groups_of(const std::string& variant,
                                           const cases::CaseParameters& p);
 
