@@ -190,12 +190,9 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
     known += (known.empty() ? "" : ", ") + g;
   for (const auto& g : groups)
     if (std::count(fittable.begin(), fittable.end(), g) != 1)
-      throw cases::InputError(
-          file + ": calibration: variant " + variant_name + " has no group '" + g +
-          "' (its groups: " + known +
-          (g == volume_group ? "; the volume group needs mass spring/volume preservation = true"
-                             : "") +
-          ")");
+      throw cases::InputError(file + ": calibration: variant " + variant_name + " has no group '" +
+                              g + "' (its groups: " + known +
+                              (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
   for (std::size_t i = 0; i < groups.size(); ++i)
     if (std::count(groups.begin(), groups.end(), groups[i]) > 1)
       throw cases::InputError(file + ": calibration: group '" + groups[i] + "' is listed twice");

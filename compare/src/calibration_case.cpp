@@ -68,7 +68,8 @@ void check_fit_groups(const cases::CaseParameters& p, const std::string& variant
       for (const auto& k : known)
         list += (list.empty() ? "" : ", ") + k;
       throw cases::InputError(p.file.string() + ": calibration: variant " + variant +
-                              " has no group '" + g + "' (its groups: " + list + ")");
+                              " has no group '" + g + "' (its groups: " + list +
+                              (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
     }
 }
 

@@ -114,8 +114,14 @@ void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
     model.set_external_force(surface_nodes[v], patch.force_n * areas[v] / total_area);
 }
 
+// The variants whose builders give the volume elements volume preservation acts on.
+bool has_volume_elements(const std::string& variant) {
+  return variant == "three_tier" || variant == "tet_edges";
+}
+
 // The volume elements of a variant that has them (three_tier's shell prisms, tet_edges'
 // tetrahedra), κ = λ(E, ν) − λ(E, 1/4) times the case's `volume` group scale.
+
 void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
   const auto& p = problem.parameters;
   ms::MassSpringModel& model = *variant.model;
@@ -123,14 +129,13 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
   for (const auto& [group, factor] : p.mass_spring.group_scales)
     if (group == volume_group) modulus *= factor;
   const auto& rest = model.network().rest_positions;
+  if (!has_volume_elements(variant.name)) return;
   ms::VolumeElements elements;
   if (variant.name == "three_tier")
     elements = ms::tier_prisms(rest, problem.surface.triangles,
                                static_cast<int>(problem.surface.num_vertices()), 3, modulus);
-  else if (variant.name == "tet_edges")
-    elements = ms::tetrahedron_elements(rest, variant.tetrahedra, modulus);
   else
-    return;
+    elements = ms::tetrahedron_elements(rest, variant.tetrahedra, modulus);
   const int all = elements.num_elements();
   // The brain's offset inner tiers fold where the surface is concave: such prisms are inverted or
   // flat at rest, and with them Newton stalled (residual ~1e-7 N after 100 iterations).
@@ -167,7 +172,8 @@ std::vector<std::string> spring_groups_of(const std::string& variant,
   std::vector<std::string> groups = spring_groups_of(variant);
   if (variant == "three_tier" && p.mass_spring.inner_diagonals)
     groups.emplace_back("tier23_diagonals");
-  if (p.mass_spring.volume_preservation) groups.emplace_back(volume_group);
+  if (p.mass_spring.volume_preservation && has_volume_elements(variant))
+    groups.emplace_back(volume_group);
   return groups;
 }
 
@@ -188,8 +194,7 @@ void check_variant_names(const cases::CaseParameters& p) {
         list += (list.empty() ? "" : ", ") + g;
       throw cases::InputError(
           p.file.string() + ": mass spring/group scales: no variant of the case has a group '" +
-          group + "'" +
-          (group == volume_group ? " (it needs mass spring/volume preservation = true)" : "") +
+          group + "'" + (group == volume_group ? " (" + std::string(volume_hint) + ")" : "") +
           "; the case's groups: " + list);
     }
 }

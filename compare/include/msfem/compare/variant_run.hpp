@@ -21,8 +21,8 @@ const std::vector<std::string>& known_variants();
 /// networks), for checking a case's names before anything is solved.
 const std::vector<std::string>& spring_groups_of(const std::string& variant);
 /// The same as the case names them: with three_tier's `tier23_diagonals` (mass spring/three
-/// tier/inner diagonals) and, under mass spring/volume preservation, `volume` (a variant without
-/// volume elements is told so when it is fitted).
+/// tier/inner diagonals) and, under mass spring/volume preservation, `volume` for the variants
+/// that have volume elements.
 std::vector<std::string> spring_groups_of(const std::string& variant,
                                           const cases::CaseParameters& p);
 
@@ -38,6 +38,9 @@ void check_variants_fit(const Problem& problem);
 /// The name under which `mass spring/group scales` and msfem calibrate scale the volume
 /// preservation modulus (`mass spring/volume preservation`).
 inline constexpr const char* volume_group = "volume";
+/// Why a case or a fit names `volume` in vain.
+inline constexpr const char* volume_hint =
+    "the volume group is three_tier's and tet_edges' under mass spring/volume preservation = true";
 
 /// Builds the variant's network with the case's material and options, and applies the shared
 /// supports, gravity, patch force and (when given) the tool as prescribed displacement of the same
