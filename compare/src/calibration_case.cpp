@@ -327,6 +327,7 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
   };
   c.fit = calibrate(c.problem, c.mesh, c.variant, c.train, c.test, options);
   if (!c.fit.converged) c.notes.push_back("the optimiser did not converge: " + c.fit.stop_reason);
+  if (!c.fit.refit_reason.empty()) c.notes.push_back(c.fit.refit_reason);
   if (const std::string few = loads_with_few_tool_nodes(c.fit.before); !few.empty())
     c.notes.push_back(
         "the tool holds fewer than " + std::to_string(min_tool_patch_nodes) + " surface nodes of " +
@@ -346,7 +347,8 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
       group_scales_assignment(calibrated.parameters.mass_spring.group_scales));
   BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
   Eigen::VectorXd x;
-  const LoadErrors check = evaluate_load(built, c.train.front(), x);
+  const LoadErrors check =
+      evaluate_load(built, c.train.front(), x, c.problem.parameters.loads.tool.path_step_m);
   c.nonlinear_check = check;
   if (c.options.linear)
     c.notes.push_back(
@@ -388,8 +390,10 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
         for (const auto& r : c.test) {
           Eigen::VectorXd xo;
           // The same model as the fit's, so that the comparison is like for like.
-          errors.push_back(c.options.linear ? evaluate_load_linear(other, r)
-                                            : evaluate_load(other, r, xo));
+          errors.push_back(
+              c.options.linear
+                  ? evaluate_load_linear(other, r)
+                  : evaluate_load(other, r, xo, c.problem.parameters.loads.tool.path_step_m));
         }
       } catch (const std::runtime_error& e) {
         // A comparison only: say so and go on, the calibration itself stands.

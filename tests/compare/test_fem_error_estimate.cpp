@@ -117,12 +117,13 @@ TEST(PlanErrorEstimate, ASecondSolveAboveTheCapIsSkippedOrRefused) {
   EXPECT_EQ(plan_error_estimate(problem_with(2, Method::none), mesh, 1, 1).method, "none");
 }
 
-// The default case's reference against one two refinements finer (about 3 M DoFs, several
+// The bonded default twin's reference against one two refinements finer (about 3 M DoFs, several
 // minutes and 10 GB: not for CI; results/BENCHMARKS.md records its figures and this command):
 //   ./build/tests/compare/compare_tests --gtest_also_run_disabled_tests
 //       --gtest_filter='*SphereIndentEstimateBracketsTheTruth'
 TEST(FemErrorEstimate, DISABLED_SphereIndentEstimateBracketsTheTruth) {
-  const auto parameters = cases::read_case(std::string(MSFEM_CASES_DIR) + "/sphere_indent.prm");
+  const auto parameters =
+      cases::read_case(std::string(MSFEM_CASES_DIR) + "/sphere_indent_bonded.prm");
   const Problem problem = make_problem(parameters);
   const auto mesh = mesh_problem(problem);
   const auto tool = std::optional<ToolPlacement>(problem.tools.front());

@@ -68,7 +68,7 @@ TEST(Sanity, VolumePreservationBringsTheNetworksCloserAtNuPointFourFive) {
   for (const std::string setting : {"false", "true"}) {
     const auto out = dir / ("run-" + setting);
     const auto r = run_msfem("run " + cases_dir +
-                             "/sphere_indent.prm --quiet --set timing/steps=100 --set "
+                             "/sphere_indent_bonded.prm --quiet --set timing/steps=100 --set "
                              "'mass spring/variants=tet_edges,three_tier' --set 'mass "
                              "spring/volume preservation=" +
                              setting + "' --out " + out.string());
@@ -108,15 +108,16 @@ TEST_P(ForceDepth, FemAndEveryVariantPushBackHarderTheDeeperTheTool) {
   const auto j = nlohmann::json::parse(read_text(dir / "run" / "summary.json"));
   const auto& normal = j["tools"][0]["outward_normal"];
   expect_force_grows(j["fem"], normal, "FEM");
-  ASSERT_EQ(j["variants"].size(), 4u);
+  ASSERT_GE(j["variants"].size(), 3u);
   for (const auto& v : j["variants"])
     expect_force_grows(v, normal, v["name"].get<std::string>());
 }
 
-// The default case presses as deep as the tool's radius, where tet_edges comes closest to
-// buckling; the twin stays in the nearly linear range.
+// The default case presses by frictionless contact as deep as the tool's radius; its bonded twin
+// too, where tet_edges comes closest to buckling; the nu = 0.25 twin stays nearly linear.
 INSTANTIATE_TEST_SUITE_P(SphereCases, ForceDepth,
-                         ::testing::Values("sphere_indent", "sphere_indent_nu025"));
+                         ::testing::Values("sphere_indent", "sphere_indent_bonded",
+                                           "sphere_indent_nu025"));
 
 }  // namespace
 }  // namespace msfem

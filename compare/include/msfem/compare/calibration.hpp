@@ -81,6 +81,11 @@ struct CalibrationFit {
   double objective_before = 0.0, objective_after = 0.0;
   std::vector<double> history;  ///< J of each evaluation, in order
   int evaluations = 0;
+  /// The first evaluations, each solved from the last one's equilibrium; the fitted point is then
+  /// re-solved as msfem run solves it (from rest), and the rest of `history` is a second fit with
+  /// every trial solved so, when the two disagreed (`refit_reason` says by how much).
+  int warm_started_evaluations = 0;
+  std::string refit_reason;
   bool converged = false;
   std::string stop_reason;  ///< NLopt's, in words
   double time_s = 0.0;
@@ -95,8 +100,11 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                          const std::vector<LoadReference>& test, const CalibrationOptions& options);
 
 /// Errors of a built variant on one reference (its tool set to the reference's), with the static
-/// solve warm-started from `x` when it has the right size; `x` is updated to the equilibrium.
-LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x);
+/// solve warm-started from `x` when it has the right size, or under a frictionless tool pressed
+/// from rest along quarters of its depth (finer with `path_step`, m), as msfem run presses; `x` is
+/// updated to the equilibrium.
+LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x,
+                         double path_step);
 
 /// The same on the model linearised at rest (one Cholesky factorisation); throws
 /// std::runtime_error where that stiffness is singular.
