@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <nlopt.hpp>
 #include <stdexcept>
@@ -180,6 +181,210 @@ struct FreeDofs {
   }
 };
 
+// The groups to fit (all the variant's when none is named), checked against the variant's own:
+// its spring groups, and the volume modulus when it has volume elements.
+std::vector<std::string> checked_groups(const BuiltVariant& base, const std::string& file,
+                                        const std::string& variant_name,
+                                        const CalibrationOptions& options) {
+  std::vector<std::string> fittable = base.model->network().spring_group_names;
+  if (base.model->volume()) fittable.push_back(volume_group);
+  std::vector<std::string> groups = options.groups;
+  if (groups.empty()) groups = fittable;
+  std::string known;
+  for (const auto& g : fittable)
+    known += (known.empty() ? "" : ", ") + g;
+  for (const auto& g : groups)
+    if (std::count(fittable.begin(), fittable.end(), g) != 1)
+      throw cases::InputError(file + ": calibration: variant " + variant_name + " has no group '" +
+                              g + "' (its groups: " + known +
+                              (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    if (std::count(groups.begin(), groups.end(), groups[i]) > 1)
+      throw cases::InputError(file + ": calibration: group '" + groups[i] + "' is listed twice");
+  if (!options.start_factors.empty() && options.start_factors.size() != groups.size())
+    throw std::invalid_argument("calibrate: one start factor per fitted group is needed");
+  return groups;
+}
+
+// The fit's parameters θ: each fitted spring group's stiffness is k_start · exp(θ_g), so it stays
+// positive and a factor of 2 too stiff weighs as much as a factor of 2 too soft; the volume
+// modulus is scaled uniformly, the case's times the start factor times exp(θ_volume). Evaluated on
+// one model per load, nonlinear or linearised at rest.
+class GroupFit {
+ public:
+  GroupFit(const Problem& problem, const BuiltVariant& base, std::vector<std::string> groups,
+           const CalibrationOptions& options)
+      : problem_(problem),
+        base_(base),
+        network_(base.model->network()),
+        groups_(std::move(groups)),
+        options_(options),
+        n_(static_cast<int>(groups_.size())),
+        group_id_(n_, -1),
+        case_stiffness_(network_.stiffness) {
+    for (int g = 0; g < n_; ++g) {
+      if (groups_[g] == volume_group)
+        volume_index_ = g;
+      else
+        group_id_[g] = network_.spring_group_id(groups_[g]);
+    }
+    if (base.model->volume()) case_modulus_ = base.model->volume()->elements().modulus;
+    if (volume_index_ >= 0 && !options.start_factors.empty())
+      volume_start_factor_ = options.start_factors[volume_index_];
+    start_stiffness_ = case_stiffness_;
+    for (int g = 0; g < n_ && !options.start_factors.empty(); ++g)
+      for (int s = 0; s < network_.num_springs(); ++s)
+        if (network_.spring_group[s] == group_id_[g])
+          start_stiffness_[s] *= options.start_factors[g];
+  }
+
+  int size() const { return n_; }
+
+  LoadModels models_on(const std::vector<LoadReference>& references) const {
+    LoadModels m = models_for(base_, references);
+    if (!options_.linear) return m;
+    // Part 0: the springs not fitted (weight 1); part g + 1: fitted group g (weight exp θ_g).
+    std::vector<Eigen::VectorXd> parts(n_ + 1, Eigen::VectorXd::Zero(network_.num_springs()));
+    for (int s = 0; s < network_.num_springs(); ++s) {
+      const auto it = std::find(group_id_.begin(), group_id_.end(), network_.spring_group[s]);
+      parts[it == group_id_.end() ? 0 : 1 + (it - group_id_.begin())][s] = start_stiffness_[s];
+    }
+    for (const auto& v : m.variants)
+      m.linear.push_back(std::make_unique<LinearisedStatics>(*v.model, parts));
+    return m;
+  }
+
+  std::vector<LoadErrors> evaluate(LoadModels& m, const std::vector<LoadReference>& references,
+                                   const std::vector<double>& theta) const {
+    if (!options_.linear)
+      return evaluate_all(m, references, stiffness_at(theta),
+                          Eigen::VectorXd(case_modulus_ * volume_factor_at(theta)),
+                          problem_.parameters.loads.tool.path_step_m);
+    // Parts: the unfitted springs, each fitted spring group, and the volume (LinearisedStatics
+    // puts it last); the volume group's own part stays empty.
+    std::vector<double> weights(n_ + 1, 1.0);
+    for (int g = 0; g < n_; ++g)
+      weights[g + 1] = std::exp(theta[g]);
+    if (base_.model->volume()) weights.push_back(volume_factor_at(theta));
+    std::vector<LoadErrors> errors;
+    for (std::size_t i = 0; i < references.size(); ++i) {
+      const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
+      errors.push_back(
+          errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]));
+    }
+    return errors;
+  }
+
+  /// Each group's start, fitted and case-file values at θ.
+  std::vector<FittedGroup> fitted_groups(const std::vector<double>& theta) const {
+    const Eigen::VectorXd fitted = stiffness_at(theta);
+    std::vector<FittedGroup> result;
+    for (int g = 0; g < n_; ++g) {
+      FittedGroup f;
+      f.group = groups_[g];
+      double k_start = 0, k_case = 0, k_fit = 0;
+      if (g == volume_index_) {
+        f.unit = "Pa";
+        f.springs = static_cast<int>(case_modulus_.size());
+        k_case = case_modulus_.sum();
+        k_start = k_case * volume_start_factor_;
+        k_fit = k_case * volume_factor_at(theta);
+      }
+      for (int s = 0; s < network_.num_springs() && g != volume_index_; ++s)
+        if (network_.spring_group[s] == group_id_[g]) {
+          ++f.springs;
+          k_start += start_stiffness_[s];
+          k_case += case_stiffness_[s];
+          k_fit += fitted[s];
+        }
+      f.start_stiffness_n_per_m = k_start / f.springs;
+      f.fitted_stiffness_n_per_m = k_fit / f.springs;
+      f.factor = k_fit / k_start;
+      // The case file's group scale for this group, times what the fit changed from the case.
+      double case_scale = 1.0;
+      for (const auto& [name, factor] : problem_.parameters.mass_spring.group_scales)
+        if (name == groups_[g]) case_scale *= factor;
+      f.case_factor = case_scale * k_fit / k_case;
+      result.push_back(f);
+    }
+    return result;
+  }
+
+ private:
+  Eigen::VectorXd stiffness_at(const std::vector<double>& theta) const {
+    Eigen::VectorXd k = start_stiffness_;
+    for (int s = 0; s < network_.num_springs(); ++s)
+      for (int g = 0; g < n_; ++g)
+        if (network_.spring_group[s] == group_id_[g]) k[s] *= std::exp(theta[g]);
+    return k;
+  }
+  double volume_factor_at(const std::vector<double>& theta) const {
+    return volume_start_factor_ * (volume_index_ >= 0 ? std::exp(theta[volume_index_]) : 1.0);
+  }
+
+  const Problem& problem_;
+  const BuiltVariant& base_;
+  const ms::SpringNetwork& network_;
+  std::vector<std::string> groups_;
+  const CalibrationOptions& options_;
+  int n_;
+  std::vector<int> group_id_;  ///< spring group id of each fitted group; -1 for the volume group
+  int volume_index_ = -1;
+  Eigen::VectorXd case_stiffness_;   ///< analytic × the case's group scales
+  Eigen::VectorXd start_stiffness_;  ///< × the start factors
+  Eigen::VectorXd case_modulus_;
+  double volume_start_factor_ = 1.0;
+};
+
+/// The lowest objective seen and where.
+struct BestPoint {
+  double j;
+  std::vector<double> theta;
+};
+
+// NLopt's BOBYQA (Sbplx for one group) from `best.theta` on the objective `j`: every evaluation
+// goes into fit.history, the lowest into `best`; a trial whose static solve fails gets a large J.
+void optimise(const std::function<double(const std::vector<double>&)>& j, BestPoint& best,
+              const CalibrationOptions& options, CalibrationFit& fit) {
+  const int n = static_cast<int>(best.theta.size());
+  auto objective = [&](const std::vector<double>& theta) {
+    double value = failed_objective;
+    try {
+      value = j(theta);
+    } catch (const std::runtime_error&) {
+      // Newton failed at this trial point: steer the optimiser away from it.
+    }
+    fit.history.push_back(value);
+    if (value < best.j) best = {value, theta};
+    if (options.on_evaluation) options.on_evaluation(static_cast<int>(fit.history.size()), value);
+    return value;
+  };
+  using Objective = decltype(objective);
+  nlopt::opt opt(n == 1 ? nlopt::LN_SBPLX : nlopt::LN_BOBYQA, static_cast<unsigned>(n));
+  const double bound = std::log(options.bound_factor);
+  opt.set_lower_bounds(std::vector<double>(n, -bound));
+  opt.set_upper_bounds(std::vector<double>(n, bound));
+  opt.set_initial_step(std::min(0.5, 0.5 * bound));
+  opt.set_xtol_abs(options.tolerance);
+  opt.set_maxeval(options.max_evaluations);
+  opt.set_min_objective([](const std::vector<double>& theta, std::vector<double>&,
+                           void* data) { return (*static_cast<Objective*>(data))(theta); },
+                        &objective);
+  std::vector<double> theta = best.theta;
+  double value = 0;
+  try {
+    const nlopt::result r = opt.optimize(theta, value);
+    fit.converged = is_converged(r);
+    fit.stop_reason = stop_reason(r);
+  } catch (const nlopt::roundoff_limited&) {
+    fit.converged = true;  // no further progress possible at this precision
+    fit.stop_reason = "round-off limited: no further progress at double precision";
+  } catch (const std::exception& e) {
+    fit.converged = false;
+    fit.stop_reason = std::string("optimiser failed: ") + e.what();
+  }
+}
+
 }  // namespace
 
 LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x,
@@ -209,197 +414,43 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                             ": calibration: the training set is empty (give --train or "
                             "calibration/train loads)");
   const BuiltVariant base = build_variant(variant_name, problem, mesh, train.front().tool);
-  const auto& network = base.model->network();
-  // The fittable groups: the spring groups, and the volume modulus when the variant has one.
-  std::vector<std::string> fittable = network.spring_group_names;
-  if (base.model->volume()) fittable.push_back(volume_group);
-  std::vector<std::string> groups = options.groups;
-  if (groups.empty()) groups = fittable;
-  std::string known;
-  for (const auto& g : fittable)
-    known += (known.empty() ? "" : ", ") + g;
-  for (const auto& g : groups)
-    if (std::count(fittable.begin(), fittable.end(), g) != 1)
-      throw cases::InputError(file + ": calibration: variant " + variant_name + " has no group '" +
-                              g + "' (its groups: " + known +
-                              (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
-  for (std::size_t i = 0; i < groups.size(); ++i)
-    if (std::count(groups.begin(), groups.end(), groups[i]) > 1)
-      throw cases::InputError(file + ": calibration: group '" + groups[i] + "' is listed twice");
-  if (!options.start_factors.empty() && options.start_factors.size() != groups.size())
-    throw std::invalid_argument("calibrate: one start factor per fitted group is needed");
-
-  const int n = static_cast<int>(groups.size());
-  // Spring group id of each fitted group; -1 for the volume group, at index `volume_index`.
-  std::vector<int> group_id(n, -1);
-  int volume_index = -1;
-  for (int g = 0; g < n; ++g) {
-    if (groups[g] == volume_group)
-      volume_index = g;
-    else
-      group_id[g] = network.spring_group_id(groups[g]);
-  }
-  const Eigen::VectorXd case_modulus =
-      base.model->volume() ? base.model->volume()->elements().modulus : Eigen::VectorXd();
-  const double volume_start_factor = volume_index >= 0 && !options.start_factors.empty()
-                                         ? options.start_factors[volume_index]
-                                         : 1.0;
-  // The volume modulus is scaled uniformly: one factor over the case's, the start's times exp θ.
-  auto volume_factor_at = [&](const std::vector<double>& theta) {
-    return volume_start_factor * (volume_index >= 0 ? std::exp(theta[volume_index]) : 1.0);
-  };
-  auto modulus_at = [&](const std::vector<double>& theta) {
-    return Eigen::VectorXd(case_modulus * volume_factor_at(theta));
-  };
-  // The case's stiffness (analytic × its group scales) and the start (× the start factors).
-  const Eigen::VectorXd case_stiffness = network.stiffness;
-  Eigen::VectorXd start_stiffness = case_stiffness;
-  for (int g = 0; g < n; ++g)
-    for (int s = 0; s < network.num_springs(); ++s)
-      if (network.spring_group[s] == group_id[g] && !options.start_factors.empty())
-        start_stiffness[s] *= options.start_factors[g];
-  auto stiffness_at = [&](const std::vector<double>& theta) {
-    Eigen::VectorXd k = start_stiffness;
-    for (int s = 0; s < network.num_springs(); ++s)
-      for (int g = 0; g < n; ++g)
-        if (network.spring_group[s] == group_id[g]) k[s] *= std::exp(theta[g]);
-    return k;
-  };
-
-  LoadModels train_models = models_for(base, train);
-  LoadModels test_models = models_for(base, test);
-  if (options.linear) {
-    // Part 0: the springs not fitted (weight 1); part g + 1: fitted group g (weight exp θ_g).
-    std::vector<Eigen::VectorXd> parts(n + 1, Eigen::VectorXd::Zero(network.num_springs()));
-    for (int s = 0; s < network.num_springs(); ++s) {
-      const auto it = std::find(group_id.begin(), group_id.end(), network.spring_group[s]);
-      parts[it == group_id.end() ? 0 : 1 + (it - group_id.begin())][s] = start_stiffness[s];
-    }
-    for (LoadModels* m : {&train_models, &test_models})
-      for (const auto& v : m->variants)
-        m->linear.push_back(std::make_unique<LinearisedStatics>(*v.model, parts));
-  }
-  auto evaluate = [&](LoadModels& m, const std::vector<LoadReference>& references,
-                      const std::vector<double>& theta) {
-    if (!options.linear)
-      return evaluate_all(m, references, stiffness_at(theta), modulus_at(theta),
-                          problem.parameters.loads.tool.path_step_m);
-    // Parts: the unfitted springs, each fitted spring group, and the volume (LinearisedStatics
-    // puts it last); the volume group's own part stays empty.
-    std::vector<double> weights(n + 1, 1.0);
-    for (int g = 0; g < n; ++g)
-      weights[g + 1] = std::exp(theta[g]);
-    if (base.model->volume()) weights.push_back(volume_factor_at(theta));
-    std::vector<LoadErrors> errors;
-    for (std::size_t i = 0; i < references.size(); ++i) {
-      const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
-      errors.push_back(
-          errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]));
-    }
-    return errors;
+  const GroupFit fitting(problem, base, checked_groups(base, file, variant_name, options), options);
+  LoadModels train_models = fitting.models_on(train);
+  LoadModels test_models = fitting.models_on(test);
+  const auto training_objective = [&](const std::vector<double>& theta) {
+    return objective_of(fitting.evaluate(train_models, train, theta), options.force_weight);
   };
   CalibrationFit fit;
-  const std::vector<double> zero(n, 0.0);
-  fit.before.train = evaluate(train_models, train, zero);
-  fit.before.test = evaluate(test_models, test, zero);
+  const std::vector<double> zero(fitting.size(), 0.0);
+  fit.before.train = fitting.evaluate(train_models, train, zero);
+  fit.before.test = fitting.evaluate(test_models, test, zero);
   fit.objective_before = objective_of(fit.before.train, options.force_weight);
 
-  std::vector<double> best_theta(n, 0.0);
-  double best = fit.objective_before;
-  auto objective = [&](const std::vector<double>& theta) {
-    double j = failed_objective;
-    try {
-      j = objective_of(evaluate(train_models, train, theta), options.force_weight);
-    } catch (const std::runtime_error&) {
-      // Newton failed at this trial point: steer the optimiser away from it.
-    }
-    fit.history.push_back(j);
-    if (j < best) {
-      best = j;
-      best_theta = theta;
-    }
-    if (options.on_evaluation) options.on_evaluation(static_cast<int>(fit.history.size()), j);
-    return j;
-  };
-  using Objective = decltype(objective);
-  const auto optimise = [&] {
-    nlopt::opt opt(n == 1 ? nlopt::LN_SBPLX : nlopt::LN_BOBYQA, static_cast<unsigned>(n));
-    const double bound = std::log(options.bound_factor);
-    opt.set_lower_bounds(std::vector<double>(n, -bound));
-    opt.set_upper_bounds(std::vector<double>(n, bound));
-    opt.set_initial_step(std::min(0.5, 0.5 * bound));
-    opt.set_xtol_abs(options.tolerance);
-    opt.set_maxeval(options.max_evaluations);
-    opt.set_min_objective([](const std::vector<double>& theta, std::vector<double>&,
-                             void* data) { return (*static_cast<Objective*>(data))(theta); },
-                          &objective);
-    std::vector<double> theta = best_theta;
-    double value = 0;
-    try {
-      const nlopt::result r = opt.optimize(theta, value);
-      fit.converged = is_converged(r);
-      fit.stop_reason = stop_reason(r);
-    } catch (const nlopt::roundoff_limited&) {
-      fit.converged = true;  // no further progress possible at this precision
-      fit.stop_reason = "round-off limited: no further progress at double precision";
-    } catch (const std::exception& e) {
-      fit.converged = false;
-      fit.stop_reason = std::string("optimiser failed: ") + e.what();
-    }
-  };
   // Fast: each trial from the last trial's equilibrium. Then the best point as msfem run solves
   // it; where the trials followed a branch that the fitted model does not reach from rest (the
   // seed's three tiers turning about the core under a frictionless tool), fit again from there
   // with every trial solved from rest.
+  BestPoint best{fit.objective_before, zero};
   train_models.from_rest = false;
-  optimise();
+  optimise(training_objective, best, options, fit);
   fit.warm_started_evaluations = static_cast<int>(fit.history.size());
   train_models.from_rest = true;
-  fit.after.train = evaluate(train_models, train, best_theta);
+  fit.after.train = fitting.evaluate(train_models, train, best.theta);
   fit.objective_after = objective_of(fit.after.train, options.force_weight);
-  if (!options.linear && std::abs(fit.objective_after - best) > 1e-6 * best) {
-    fit.refit_reason = "the best warm-started trial (J " + std::to_string(best) +
+  if (!options.linear && std::abs(fit.objective_after - best.j) > 1e-6 * best.j) {
+    fit.refit_reason = "the best warm-started trial (J " + std::to_string(best.j) +
                        ") re-solved from rest gives J " + std::to_string(fit.objective_after) +
                        ": fitted again with every trial solved from rest";
-    best = std::min(fit.objective_after, fit.objective_before);
-    if (fit.objective_before < fit.objective_after) best_theta = zero;
-    optimise();
-    fit.after.train = evaluate(train_models, train, best_theta);
+    best = fit.objective_before < fit.objective_after ? BestPoint{fit.objective_before, zero}
+                                                      : BestPoint{fit.objective_after, best.theta};
+    optimise(training_objective, best, options, fit);
+    fit.after.train = fitting.evaluate(train_models, train, best.theta);
     fit.objective_after = objective_of(fit.after.train, options.force_weight);
   }
   fit.evaluations = static_cast<int>(fit.history.size());
-
-  const Eigen::VectorXd fitted = stiffness_at(best_theta);
-  fit.after.test = evaluate(test_models, test, best_theta);
+  fit.after.test = fitting.evaluate(test_models, test, best.theta);
   fit.test_equilibria = test_models.x;
-  for (int g = 0; g < n; ++g) {
-    FittedGroup f;
-    f.group = groups[g];
-    double k_start = 0, k_case = 0, k_fit = 0;
-    if (g == volume_index) {
-      f.unit = "Pa";
-      f.springs = static_cast<int>(case_modulus.size());
-      k_case = case_modulus.sum();
-      k_start = k_case * volume_start_factor;
-      k_fit = k_case * volume_factor_at(best_theta);
-    }
-    for (int s = 0; s < network.num_springs() && g != volume_index; ++s)
-      if (network.spring_group[s] == group_id[g]) {
-        ++f.springs;
-        k_start += start_stiffness[s];
-        k_case += case_stiffness[s];
-        k_fit += fitted[s];
-      }
-    f.start_stiffness_n_per_m = k_start / f.springs;
-    f.fitted_stiffness_n_per_m = k_fit / f.springs;
-    f.factor = k_fit / k_start;
-    // The case file's group scale for this group, times what the fit changed from the case.
-    double case_scale = 1.0;
-    for (const auto& [name, factor] : problem.parameters.mass_spring.group_scales)
-      if (name == groups[g]) case_scale *= factor;
-    f.case_factor = case_scale * k_fit / k_case;
-    fit.groups.push_back(f);
-  }
+  fit.groups = fitting.fitted_groups(best.theta);
   fit.time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return fit;
 }
