@@ -134,7 +134,8 @@ std::vector<bool> prescribed_surface_vertices(const Problem& problem,
 }
 
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                      const std::optional<ToolPlacement>& tool) {
+                      const std::optional<ToolPlacement>& tool,
+                      const fem_reference::VectorField& initial_displacement) {
   const auto& p = problem.parameters;
   check_no_rigid_motion(problem, mesh, tool);
   fem_reference::ElasticityModel model;
@@ -144,6 +145,7 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
   model.material.density = p.material.density_kg_per_m3;
   model.material.gravity = p.loads.gravity_m_per_s2;
   model.solver.relative_tolerance = p.fem.relative_tolerance;
+  model.initial_displacement = initial_displacement;
   model.solver.preconditioner = p.fem.solver == "mumps" ? fem_reference::Preconditioner::mumps
                                 : p.fem.solver == "cg_boomeramg"
                                     ? fem_reference::Preconditioner::boomer_amg

@@ -345,6 +345,18 @@ void PetscLinearSystem::apply_prescribed_values(const std::vector<PetscInt>& row
                                  solution_, rhs_));
 }
 
+void PetscLinearSystem::set_start(const std::vector<double>& start) {
+  PetscInt first = 0, end = 0;
+  MSFEM_PETSC(VecGetOwnershipRange(solution_, &first, &end));
+  std::vector<PetscInt> rows;
+  for (PetscInt i = first; i < end; ++i)
+    rows.push_back(i);
+  MSFEM_PETSC(VecSetValues(solution_, PetscInt(rows.size()), rows.data(), start.data() + first,
+                           INSERT_VALUES));
+  MSFEM_PETSC(VecAssemblyBegin(solution_));
+  MSFEM_PETSC(VecAssemblyEnd(solution_));
+}
+
 void PetscLinearSystem::keep_base_system() {
   MatDestroy(&base_matrix_);
   VecDestroy(&base_rhs_);

@@ -79,6 +79,10 @@ class PetscLinearSystem {
                       const std::vector<std::array<double, 9>>& blocks,
                       const std::vector<std::array<double, 3>>& rhs);
 
+  /// The next solve's first iterate: `start` holds every DoF (this rank's owned ones are used);
+  /// prescribed rows must already hold their values.
+  void set_start(const std::vector<double>& start);
+
   /// With a coarse space, CG + GAMG becomes CG + a two-level V-cycle: Chebyshev with point-block
   /// Jacobi on this matrix, one GAMG V-cycle on the Galerkin product P^T K P as the coarse solve.
   void set_coarse_space(CoarseSpace space) { coarse_space_ = std::move(space); }

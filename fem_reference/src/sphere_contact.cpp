@@ -40,8 +40,12 @@ class ActiveSetIteration {
     collect_candidates();
     std::vector<double> u = initial_displacement();
     std::vector<char> active = active_flags(u);
-    start_at_hertz_radius(active);
-    push_out_along_axis(active, u);
+    if (p_.model.initial_displacement) {
+      p_.linear_system->set_start(u);
+    } else {
+      start_at_hertz_radius(active);
+      push_out_along_axis(active, u);
+    }
     std::vector<std::vector<char>> history{active};
     detail::KrylovReport total;
     const int max_iterations = max_allowed_iterations();
@@ -129,10 +133,15 @@ class ActiveSetIteration {
                                     "' has no free boundary node among its candidates");
   }
 
+  /// The prescribed values, and the model's guess (or zero) elsewhere.
   std::vector<double> initial_displacement() const {
     std::vector<double> u(p_.dof_handler.n_dofs(), 0.0);
-    for (std::size_t i = 0; i < u.size(); ++i)
-      if (prescribed(i)) u[i] = p_.prescribed_value[i];
+    const auto& guess = p_.model.initial_displacement;
+    for (std::size_t dof = 0; dof < u.size(); dof += dim) {
+      const Eigen::Vector3d g = guess ? guess(reference_position(dof)) : Eigen::Vector3d::Zero();
+      for (int c = 0; c < dim; ++c)
+        u[dof + c] = prescribed(dof + c) ? p_.prescribed_value[dof + c] : g[c];
+    }
     return u;
   }
 
@@ -199,7 +208,11 @@ class ActiveSetIteration {
   /// zero, would otherwise flip in and out for ever. A node kept in contact may pull, or one kept
   /// out may enter, by that band: a hundredth of a node's contact force.
   std::vector<char> active_flags(const std::vector<double>& u) const {
+    // Before any set: the guess's deepest node (a cold start's overlap never decides by the band).
     double deepest = 0.0;
+    if (active_.empty() && p_.model.initial_displacement)
+      for (std::size_t k = 0; k < candidates_.size(); ++k)
+        deepest = std::max(deepest, -gap(candidates_[k], u));
     for (std::size_t k = 0; k < active_.size(); ++k)
       if (active_[k])
         deepest = std::max(deepest,

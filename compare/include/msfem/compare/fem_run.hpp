@@ -44,9 +44,11 @@ void check_no_rigid_motion(const Problem& problem, const fem_reference::VolumeMe
 /// The frictionless tool as the FEM's rigid sphere, named "tool": every boundary node a candidate.
 fem_reference::SphereObstacle tool_obstacle(const ToolPlacement& tool);
 
-/// Solves the problem's FEM for `tool` (none: gravity and patch force only).
+/// Solves the problem's FEM for `tool` (none: gravity and patch force only). A frictionless tool's
+/// contact iteration starts from `initial_displacement` when given (a coarser solve's answer).
 FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                      const std::optional<ToolPlacement>& tool);
+                      const std::optional<ToolPlacement>& tool,
+                      const fem_reference::VectorField& initial_displacement = {});
 
 /// Surface vertices that a support or the tool prescribes (excluded from the error metrics).
 std::vector<bool> prescribed_surface_vertices(const Problem& problem,

@@ -110,6 +110,10 @@ struct ElasticityModel {
   VectorField body_force;  ///< optional, N/m^3, added to density * gravity
   std::vector<SphereObstacle> obstacles;
   SolverSettings solver;
+  /// Optional, m: a guess of the displacement at a point (a coarser mesh's solution). With
+  /// obstacles, the contact iteration starts from it (its active set and normals) instead of from
+  /// Hertz's radius; the answer is the same, reached in fewer iterations.
+  VectorField initial_displacement;
 };
 
 struct SolveStatistics {
