@@ -47,6 +47,37 @@ void check_mesh_cost(const Problem& problem, const fem_reference::MeshOptions& o
 
 }  // namespace
 
+namespace {
+
+// The case's patch force as a uniform traction over the surface triangles whose centroids lie
+// within its radius of the surface vertex farthest along its direction.
+std::optional<fem_reference::Traction> patch_traction(const Problem& problem) {
+  const auto& patch = problem.parameters.loads.patch_force;
+  if (!patch.enabled) return std::nullopt;
+  const int center = farthest_vertex(problem.surface, problem.centroid, patch.direction);
+  const Eigen::Vector3d c = problem.surface.vertices.row(center).transpose();
+  // Spread the total force as a uniform traction over the patch's area on the surface.
+  double patch_area = 0;
+  const auto& s = problem.surface;
+  for (Eigen::Index t = 0; t < s.num_triangles(); ++t) {
+    const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)),
+                          b = s.vertices.row(s.triangles(t, 1)),
+                          d = s.vertices.row(s.triangles(t, 2));
+    if (((a + b + d) / 3 - c).norm() <= patch.radius_m)
+      patch_area += 0.5 * (b - a).cross(d - a).norm();
+  }
+  if (patch_area > 0) {
+    fem_reference::Traction traction;
+    traction.name = "patch";
+    traction.region = fem_reference::ball(c, patch.radius_m);
+    traction.traction = fem_reference::uniform_traction(patch.force_n / patch_area);
+    return traction;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 fem_reference::SphereObstacle tool_obstacle(const ToolPlacement& tool) {
   fem_reference::SphereObstacle sphere;
   sphere.name = "tool";
@@ -155,28 +186,7 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
   if (tool && tool->frictionless) model.obstacles.push_back(tool_obstacle(*tool));
   model.supports.push_back(fem_reference::fixed_support("fixed", problem.fixed_region));
 
-  const auto& patch = p.loads.patch_force;
-  if (patch.enabled) {
-    const int center = farthest_vertex(problem.surface, problem.centroid, patch.direction);
-    const Eigen::Vector3d c = problem.surface.vertices.row(center).transpose();
-    // Spread the total force as a uniform traction over the patch's area on the surface.
-    double patch_area = 0;
-    const auto& s = problem.surface;
-    for (Eigen::Index t = 0; t < s.num_triangles(); ++t) {
-      const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)),
-                            b = s.vertices.row(s.triangles(t, 1)),
-                            d = s.vertices.row(s.triangles(t, 2));
-      if (((a + b + d) / 3 - c).norm() <= patch.radius_m)
-        patch_area += 0.5 * (b - a).cross(d - a).norm();
-    }
-    if (patch_area > 0) {
-      fem_reference::Traction traction;
-      traction.name = "patch";
-      traction.region = fem_reference::ball(c, patch.radius_m);
-      traction.traction = fem_reference::uniform_traction(patch.force_n / patch_area);
-      model.tractions.push_back(traction);
-    }
-  }
+  if (auto traction = patch_traction(problem)) model.tractions.push_back(*traction);
 
   FemSolution solution;
   solution.solver = p.fem.solver;

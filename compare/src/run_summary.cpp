@@ -141,7 +141,10 @@ std::string machine_description() {
          std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
-nlohmann::json summary_json(const CaseRun& run) {
+namespace {
+
+// The reference: its solve, its own error estimate, its force-depth curve and contact, per load.
+nlohmann::json fem_json(const CaseRun& run) {
   const auto& p = run.problem.parameters;
   const auto& st = run.fem.statistics;
   nlohmann::json fem = {
@@ -198,51 +201,51 @@ nlohmann::json summary_json(const CaseRun& run) {
     }
     fem["loads"] = loads;
   }
+  return fem;
+}
 
-  nlohmann::json variants = nlohmann::json::array();
-  for (const auto& v : run.variants) {
-    const nlohmann::json fd = curve_json(v.force_depth);
-    variants.push_back(
-        {{"name", v.name},
-         {"nodes", v.nodes},
-         {"springs", v.springs},
-         {"contact_refinement_added_nodes", json_or_null(v.refinement_added_nodes)},
-         {"rel_l2_error", v.errors.all.rel_l2_error},
-         {"rms_error_m", v.errors.all.rms_error_m},
-         {"max_error_m", v.errors.all.max_error_m},
-         {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
-         {"contact_zone", zone(v.errors.contact_zone)},
-         {"far_field", zone(v.errors.far_field)},
-         {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(v.tool_force)},
-         {"reaction_force_rel_error", run.problem.tools.empty()
-                                          ? nlohmann::json()
-                                          : nlohmann::json(v.reaction_force_rel_error)},
-         {"volume_change", v.volume_change},
-         {"patch_mean_displacement_m", optional_vec(v.patch_mean_displacement)},
-         {"patch_displacement_rel_error", json_or_null(v.patch_displacement_rel_error)},
-         {"not_resolved_by_reference", unresolved_metrics(run, v)},
-         {"integrator", v.timing.integrator},
-         {"dt_s", v.timing.dt_s},
-         {"steps_per_second", v.timing.steps_per_second},
-         {"stable_dt_s", v.timing.stable_dt_s},
-         {"predicted_stable_dt_s", v.timing.predicted_stable_dt_s},
-         {"realtime_factor", v.timing.realtime_factor},
-         {"settle_time_s", v.timing.settle_time_s},
-         {"settled", v.timing.settled},
-         {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
-         {"newton_iterations", v.newton_iterations},
-         {"force_depth", fd},
-         {"force_depth_monotone", json_or_null(v.force_depth_monotone)},
-         {"force_depth_exponent",
-          json_or_null(force_depth_exponent(v.force_depth, tool_of(run, 0)))},
-         {"inverted_elements", json_or_null(v.inverted_elements)},
-         {"warnings", v.warnings},
-         {"parameters", v.parameters}});
-    if (!run.other_tools.empty()) variants.back()["loads"] = variant_loads(run, v);
-  }
-  nlohmann::json failed = nlohmann::json::array();
-  for (const auto& [name, why] : run.failed_variants)
-    failed.push_back({{"name", name}, {"error", why}});
+// One variant: its errors, force, timing, force-depth curve, and (with more tools) per load.
+nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
+  const nlohmann::json fd = curve_json(v.force_depth);
+  nlohmann::json j = {
+      {"name", v.name},
+      {"nodes", v.nodes},
+      {"springs", v.springs},
+      {"contact_refinement_added_nodes", json_or_null(v.refinement_added_nodes)},
+      {"rel_l2_error", v.errors.all.rel_l2_error},
+      {"rms_error_m", v.errors.all.rms_error_m},
+      {"max_error_m", v.errors.all.max_error_m},
+      {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
+      {"contact_zone", zone(v.errors.contact_zone)},
+      {"far_field", zone(v.errors.far_field)},
+      {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(v.tool_force)},
+      {"reaction_force_rel_error",
+       run.problem.tools.empty() ? nlohmann::json() : nlohmann::json(v.reaction_force_rel_error)},
+      {"volume_change", v.volume_change},
+      {"patch_mean_displacement_m", optional_vec(v.patch_mean_displacement)},
+      {"patch_displacement_rel_error", json_or_null(v.patch_displacement_rel_error)},
+      {"not_resolved_by_reference", unresolved_metrics(run, v)},
+      {"integrator", v.timing.integrator},
+      {"dt_s", v.timing.dt_s},
+      {"steps_per_second", v.timing.steps_per_second},
+      {"stable_dt_s", v.timing.stable_dt_s},
+      {"predicted_stable_dt_s", v.timing.predicted_stable_dt_s},
+      {"realtime_factor", v.timing.realtime_factor},
+      {"settle_time_s", v.timing.settle_time_s},
+      {"settled", v.timing.settled},
+      {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
+      {"newton_iterations", v.newton_iterations},
+      {"force_depth", fd},
+      {"force_depth_monotone", json_or_null(v.force_depth_monotone)},
+      {"force_depth_exponent", json_or_null(force_depth_exponent(v.force_depth, tool_of(run, 0)))},
+      {"inverted_elements", json_or_null(v.inverted_elements)},
+      {"warnings", v.warnings},
+      {"parameters", v.parameters}};
+  if (!run.other_tools.empty()) j["loads"] = variant_loads(run, v);
+  return j;
+}
+
+nlohmann::json tools_json(const CaseRun& run) {
   nlohmann::json tools = nlohmann::json::array();
   for (const auto& t : run.problem.tools)
     tools.push_back({{"vertex", t.vertex},
@@ -251,6 +254,21 @@ nlohmann::json summary_json(const CaseRun& run) {
                      {"radius_m", t.radius},
                      {"depth_m", t.depth},
                      {"mode", t.frictionless ? "contact" : "bonded"}});
+  return tools;
+}
+
+}  // namespace
+
+nlohmann::json summary_json(const CaseRun& run) {
+  const auto& p = run.problem.parameters;
+  nlohmann::json variants = nlohmann::json::array();
+  for (const auto& v : run.variants)
+    variants.push_back(variant_json(run, v));
+  nlohmann::json failed = nlohmann::json::array();
+  for (const auto& [name, why] : run.failed_variants)
+    failed.push_back({{"name", name}, {"error", why}});
+  const nlohmann::json fem = fem_json(run);
+  const nlohmann::json tools = tools_json(run);
   return {{"case", p.name},
           {"case_file", p.file.string()},
           {"git_revision", git_revision()},
