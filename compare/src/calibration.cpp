@@ -136,6 +136,14 @@ StaticSolution equilibrium_from_rest(BuiltVariant& variant, const LoadReference&
   return s;
 }
 
+// The load's equilibrium from `x`, or from rest as msfem run reaches it when `x` is empty.
+StaticSolution equilibrium(BuiltVariant& variant, const LoadReference& reference,
+                           const Eigen::VectorXd& x, double path_step) {
+  if (x.size() == 0) return equilibrium_from_rest(variant, reference, path_step);
+  set_tool_depth(variant, reference.tool);
+  return solve_variant_static(variant, x);
+}
+
 std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadReference>& references,
                                      const Eigen::VectorXd& stiffness,
                                      const Eigen::VectorXd& volume_modulus, double path_step) {
@@ -146,10 +154,8 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadRefere
     // A frictionless tool's penalty is picked from the stiffness, as msfem run picks it for the
     // fitted model.
     m.variants[i].contact_pressure_penalty = 0.0;
-    set_tool_depth(m.variants[i], references[i].tool);
-    const StaticSolution s = m.from_rest || m.x[i].size() == 0
-                                 ? equilibrium_from_rest(m.variants[i], references[i], path_step)
-                                 : solve_variant_static(m.variants[i], m.x[i]);
+    const StaticSolution s = equilibrium(m.variants[i], references[i],
+                                         m.from_rest ? Eigen::VectorXd() : m.x[i], path_step);
     m.x[i] = s.x;
     errors.push_back(
         errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i], s.x));
@@ -389,9 +395,7 @@ void optimise(const std::function<double(const std::vector<double>&)>& j, BestPo
 
 LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x,
                          double path_step) {
-  set_tool_depth(variant, reference.tool);
-  const StaticSolution s = x.size() == 0 ? equilibrium_from_rest(variant, reference, path_step)
-                                         : solve_variant_static(variant, x);
+  const StaticSolution s = equilibrium(variant, reference, x, path_step);
   x = s.x;
   return errors_against(reference, s.surface_displacement, s.tool_force, variant, s.x);
 }

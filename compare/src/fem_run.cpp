@@ -45,10 +45,6 @@ void check_mesh_cost(const Problem& problem, const fem_reference::MeshOptions& o
   }
 }
 
-}  // namespace
-
-namespace {
-
 // The case's patch force as a uniform traction over the surface triangles whose centroids lie
 // within its radius of the surface vertex farthest along its direction.
 std::optional<fem_reference::Traction> patch_traction(const Problem& problem) {
