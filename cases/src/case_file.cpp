@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -307,6 +308,26 @@ void apply_override(ParameterHandler& prm, const std::string& assignment) {
     prm.leave_subsection();
 }
 
+// Each step of the loading path is a static solve per variant and load: a step so small that the
+// path would take more than this many is refused before any solve, not run for hours.
+constexpr int max_path_steps = 1000;
+
+void check_path_step(const ToolParameters& tool) {
+  if (!tool.enabled || !(tool.path_step_m > 0)) return;
+  double deepest = tool.depth_m;
+  for (double d : tool.curve_depths_m)
+    deepest = std::max(deepest, d);
+  const double steps = deepest / tool.path_step_m;
+  if (steps > max_path_steps) {
+    char message[256];
+    std::snprintf(message, sizeof message,
+                  "loads/tool/path step = %g m would press to %g m in %.3g steps, above the %d "
+                  "msfem takes; use a larger step (or 0: the curve depths only)",
+                  tool.path_step_m, deepest, steps, max_path_steps);
+    throw InputError(message);
+  }
+}
+
 CaseParameters extract(ParameterHandler& prm) {
   CaseParameters c;
   prm.enter_subsection("geometry");
@@ -358,6 +379,7 @@ CaseParameters extract(ParameterHandler& prm) {
   prm.leave_subsection();
   if (tool.enabled && !(tool.radius_m > 0 && tool.depth_m > 0))
     throw InputError("loads/tool: radius and depth must be > 0 when the tool is enabled");
+  check_path_step(tool);
   prm.enter_subsection("patch force");
   auto& patch = c.loads.patch_force;
   patch.enabled = prm.get_bool("enabled");

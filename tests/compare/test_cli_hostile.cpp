@@ -96,6 +96,8 @@ const Hostile hostile[] = {
          "region=sphere' --set 'support/sphere radius=1e-4'",
      "support/fixed region"},
     {"UnknownIntegrator", "run " + sphere + " --set 'timing/integrator=verlet'", "verlet"},
+    {"PathStepThatWouldPressForever", "run " + sphere + " --set 'loads/tool/path step=1e-9'",
+     "loads/tool/path step"},
     {"ErrorEstimateDegreeAtP2", "run " + sphere + " --set 'fem/error estimate=degree'",
      "fem/error estimate = degree needs fem/degree = 1"},
     {"UnknownFitGroup", "calibrate " + sphere + " --fit nope", "has no group 'nope'"},
