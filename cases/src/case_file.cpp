@@ -7,7 +7,6 @@
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -17,6 +16,7 @@
 #include "case_file_text.hpp"
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/setting_names.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/massspring/integrators.hpp"
 
@@ -27,7 +27,6 @@ using dealii::ParameterHandler;
 namespace Patterns = dealii::Patterns;
 
 const char* const default_output_directory = "results/runs";
-const char* const variant_names = "three_tier|single_layer|tet_edges|skeleton";
 
 Patterns::List point_pattern() {
   return Patterns::List(Patterns::Double(), 3, 3, ",");
@@ -38,7 +37,7 @@ void declare_geometry(ParameterHandler& prm) {
   prm.declare_entry("source", "icosphere:3:0.05", Patterns::Anything(),
                     "Closed surface: a file (.obj .stl .off .ply; relative to the case file) or "
                     "a generator, icosphere:LEVEL[:RADIUS_M] or ellipsoid:LEVEL:A:B:C (metres).");
-  prm.declare_entry("unit", "m", Patterns::Selection("m|cm|mm"),
+  prm.declare_entry("unit", "m", Patterns::Selection(selection_of<LengthUnit>()),
                     "Unit of the surface file's coordinates; msfem works in metres.");
   prm.declare_entry("simplify to vertices", "0", Patterns::Integer(0),
                     "Edge-collapse the surface to this many vertices (0 keeps it as read).");
@@ -62,7 +61,7 @@ void declare_material(ParameterHandler& prm) {
 void declare_support(ParameterHandler& prm) {
   prm.enter_subsection("support");
   prm.declare_entry("fixed region", "inner core",
-                    Patterns::Selection("inner core|half space|sphere"),
+                    Patterns::Selection(selection_of<SupportParameters::Kind>()),
                     "Which nodes are fixed: inside the surface scaled by 1/scale about its "
                     "centroid, in a half space, or in a sphere.");
   prm.declare_entry("inner core scale", "2.0", Patterns::Double(1.0),
@@ -82,7 +81,7 @@ void declare_loads(ParameterHandler& prm) {
   prm.enter_subsection("tool");
   prm.declare_entry("enabled", "true", Patterns::Bool(), "Press a rigid spherical tool.");
   prm.declare_entry(
-      "mode", "bonded", Patterns::Selection("bonded|prescribed|contact"),
+      "mode", "bonded", Patterns::Selection(selection_of<ToolParameters::Mode>()),
       "contact: frictionless contact in both models (the FEM's surface nodes may not enter the "
       "sphere and are pushed only; the springs' surface triangles feel its pressure), what a "
       "haptic device renders. bonded (alias prescribed): every surface node inside the pushed "
@@ -117,9 +116,10 @@ void declare_loads(ParameterHandler& prm) {
 void declare_mass_spring(ParameterHandler& prm) {
   prm.enter_subsection("mass spring");
   prm.declare_entry("variants", "three_tier, single_layer, tet_edges, skeleton",
-                    Patterns::List(Patterns::Selection(variant_names), 1),
+                    Patterns::List(Patterns::Selection(selection_of<Variant>()), 1),
                     "Mass-spring variants to build and compare with the FEM.");
-  prm.declare_entry("stiffness model", "lloyd", Patterns::Selection("lloyd|van_gelder"),
+  prm.declare_entry("stiffness model", "lloyd",
+                    Patterns::Selection(selection_of<massspring::TetStiffnessRule>()),
                     "Analytic starting stiffness: Lloyd et al. 2007 or van Gelder 1998.");
   prm.declare_entry("damping ratio", "0.5", Patterns::Double(0),
                     "Spring dampers as a fraction of critical damping.");
@@ -136,7 +136,8 @@ void declare_mass_spring(ParameterHandler& prm) {
                     "Tier 2 is the surface scaled by 1/scale about its centroid.");
   prm.declare_entry("inner tier scale", "2.0", Patterns::Double(1.0),
                     "Tier 3 (fixed) is the surface scaled by 1/scale.");
-  prm.declare_entry("inner tiers", "scaled", Patterns::Selection("scaled|offset"),
+  prm.declare_entry("inner tiers", "scaled",
+                    Patterns::Selection(selection_of<massspring::InnerTierMethod>()),
                     "Build inner tiers by scaling, or by offsetting along the inward normal "
                     "(safe for concave surfaces).");
   prm.declare_entry("inner diagonals", "false", Patterns::Bool(),
@@ -175,7 +176,7 @@ void declare_fem_timing_output(ParameterHandler& prm) {
                     "Polynomial degree of the simplex elements (P1 locks near ν = 0.5).");
   prm.declare_entry("cell size", "0", Patterns::Double(0),
                     "Target tetrahedron size (m); 0: the surface's mean edge length.");
-  prm.declare_entry("solver", "cg_gamg", Patterns::Selection("cg_gamg|cg_boomeramg|mumps"),
+  prm.declare_entry("solver", "cg_gamg", Patterns::Selection(selection_of<FemSolver>()),
                     "PETSc solver: CG with GAMG (rigid-body near-null space; at degree 2 GAMG "
                     "acts on the mesh's P1 level below a Chebyshev-smoothed P2 level), CG with "
                     "hypre BoomerAMG, or the MUMPS direct solver.");
@@ -191,7 +192,7 @@ void declare_fem_timing_output(ParameterHandler& prm) {
   prm.declare_entry("tool cell size", "0", Patterns::Double(0),
                     "Edge length (m) of the refined surface at the tool; 0: tool radius / 3.");
   prm.declare_entry(
-      "error estimate", "auto", Patterns::Selection("auto|refine|degree|none"),
+      "error estimate", "auto", Patterns::Selection(selection_of<FemParameters::ErrorEstimate>()),
       "The reference's own discretisation error, from a second solve of each tool load: refine "
       "(the same degree on the mesh with every tetrahedron split into eight), degree (degree 2 "
       "on the same mesh; needs degree = 1), none. auto: degree at degree 1; refine at degree 2 "
@@ -202,7 +203,7 @@ void declare_fem_timing_output(ParameterHandler& prm) {
   prm.leave_subsection();
   prm.enter_subsection("timing");
   prm.declare_entry("integrator", "symplectic_euler",
-                    Patterns::Selection(massspring::integrator_names("|")),
+                    Patterns::Selection(selection_of<massspring::IntegratorKind>()),
                     "Integrator whose steps are timed.");
   prm.declare_entry("dt", "0", Patterns::Double(0),
                     "Time step (s); 0: half the estimated stable step of each variant.");
@@ -218,7 +219,8 @@ void declare_fem_timing_output(ParameterHandler& prm) {
 
 void declare_calibration(ParameterHandler& prm) {
   prm.enter_subsection("calibration");
-  prm.declare_entry("variant", "", Patterns::Anything(),
+  // The empty first choice is "not set".
+  prm.declare_entry("variant", "", Patterns::Selection("|" + selection_of<Variant>()),
                     "Variant msfem calibrate fits when --variant is not given (empty: the first "
                     "of mass spring/variants).");
   prm.declare_entry("fit groups", "", Patterns::List(Patterns::Anything()),
@@ -238,7 +240,7 @@ void declare_calibration(ParameterHandler& prm) {
                     "Each fitted factor stays within [1/b, b] of its starting value.");
   prm.declare_entry("target damping ratio", "0.5", Patterns::Double(0),
                     "Damping ratio of the tool-response mode that the damping fit aims for.");
-  prm.declare_entry("model", "nonlinear", Patterns::Selection("nonlinear|linear"),
+  prm.declare_entry("model", "nonlinear", Patterns::Selection(selection_of<CalibrationModel>()),
                     "Spring model the fit solves: nonlinear static equilibrium (Newton, as msfem "
                     "run), or linearised at rest (one Cholesky factorisation per load and "
                     "evaluation: large models, small indentations).");
@@ -328,27 +330,33 @@ void check_path_step(const ToolParameters& tool) {
   }
 }
 
-CaseParameters extract(ParameterHandler& prm) {
-  CaseParameters c;
+// An enumerated key of the current subsection; its Selection pattern already refused other names.
+template <typename Enum>
+Enum setting(const ParameterHandler& prm, const std::string& key) {
+  return parse_setting<Enum>(prm.get(key), key);
+}
+
+void extract_geometry(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("geometry");
   c.geometry.source = prm.get("source");
-  c.geometry.unit = parse_length_unit(prm.get("unit"));
+  c.geometry.unit = setting<LengthUnit>(prm, "unit");
   c.geometry.simplify_to_vertices = prm.get_integer("simplify to vertices");
   c.geometry.smoothing_iterations = prm.get_integer("smoothing iterations");
   prm.leave_subsection();
+}
 
+void extract_material(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("material");
   c.material = {prm.get_double("youngs modulus"), prm.get_double("poisson ratio"),
                 prm.get_double("density")};
   prm.leave_subsection();
   if (!(c.material.youngs_modulus_pa > 0)) throw InputError("material/youngs modulus must be > 0");
   if (!(c.material.density_kg_per_m3 > 0)) throw InputError("material/density must be > 0");
+}
 
+void extract_support(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("support");
-  const std::string region = prm.get("fixed region");
-  c.support.kind = region == "inner core"   ? SupportParameters::Kind::inner_core
-                   : region == "half space" ? SupportParameters::Kind::half_space
-                                            : SupportParameters::Kind::sphere;
+  c.support.kind = setting<SupportParameters::Kind>(prm, "fixed region");
   c.support.inner_core_scale = prm.get_double("inner core scale");
   c.support.half_space_point = parse_point(prm.get("half space point"));
   c.support.half_space_normal =
@@ -360,14 +368,15 @@ CaseParameters extract(ParameterHandler& prm) {
     throw InputError("support/inner core scale must be > 1");
   if (c.support.kind == SupportParameters::Kind::sphere && !(c.support.sphere_radius_m > 0))
     throw InputError("support/sphere radius must be > 0 for a fixed sphere");
+}
 
+void extract_loads(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("loads");
   c.loads.gravity_m_per_s2 = parse_point(prm.get("gravity"));
   prm.enter_subsection("tool");
   auto& tool = c.loads.tool;
   tool.enabled = prm.get_bool("enabled");
-  tool.mode = prm.get("mode") == "contact" ? ToolParameters::Mode::contact
-                                           : ToolParameters::Mode::prescribed;
+  tool.mode = setting<ToolParameters::Mode>(prm, "mode");
   tool.directions.clear();
   for (const auto& d : dealii::Utilities::split_string_list(prm.get("directions"), ';'))
     tool.directions.push_back(unit_vector(d, "loads/tool/directions"));
@@ -388,11 +397,15 @@ CaseParameters extract(ParameterHandler& prm) {
   patch.force_n = parse_point(prm.get("force"));
   prm.leave_subsection();
   prm.leave_subsection();
+}
 
+void extract_mass_spring(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("mass spring");
   auto& ms = c.mass_spring;
-  ms.variants = dealii::Utilities::split_string_list(prm.get("variants"));
-  ms.stiffness_model = prm.get("stiffness model");
+  ms.variants.clear();
+  for (const auto& name : dealii::Utilities::split_string_list(prm.get("variants")))
+    ms.variants.push_back(parse_setting<Variant>(name, "mass spring/variants"));
+  ms.stiffness_model = setting<massspring::TetStiffnessRule>(prm, "stiffness model");
   ms.damping_ratio = prm.get_double("damping ratio");
   for (const auto& entry : dealii::Utilities::split_string_list(prm.get("group scales"))) {
     const auto colon = entry.find(':');
@@ -409,7 +422,7 @@ CaseParameters extract(ParameterHandler& prm) {
   prm.enter_subsection("three tier");
   ms.middle_tier_scale = prm.get_double("middle tier scale");
   ms.inner_tier_scale = prm.get_double("inner tier scale");
-  ms.inner_tiers = prm.get("inner tiers");
+  ms.inner_tiers = setting<massspring::InnerTierMethod>(prm, "inner tiers");
   ms.inner_diagonals = prm.get_bool("inner diagonals");
   prm.leave_subsection();
   prm.enter_subsection("skeleton");
@@ -424,30 +437,36 @@ CaseParameters extract(ParameterHandler& prm) {
   prm.leave_subsection();
   if (!(ms.inner_tier_scale > ms.middle_tier_scale))
     throw InputError("mass spring/three tier: inner tier scale must exceed middle tier scale");
+}
 
+void extract_fem_timing_output(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("fem");
   c.fem = {static_cast<int>(prm.get_integer("degree")),
            prm.get_double("cell size"),
-           prm.get("solver"),
+           setting<FemSolver>(prm, "solver"),
            prm.get_double("relative tolerance"),
            prm.get_bool("refine at tool"),
            prm.get_double("tool cell size"),
-           error_estimate_from_name(prm.get("error estimate"))};
+           setting<FemParameters::ErrorEstimate>(prm, "error estimate")};
   if (c.fem.error_estimate == FemParameters::ErrorEstimate::degree && c.fem.degree != 1)
     throw InputError(
         "fem/error estimate = degree needs fem/degree = 1 (deal.II has no cubic tetrahedron to "
         "go above degree 2); use refine");
   prm.leave_subsection();
   prm.enter_subsection("timing");
-  c.timing = {prm.get("integrator"), prm.get_double("dt"),
+  c.timing = {setting<massspring::IntegratorKind>(prm, "integrator"), prm.get_double("dt"),
               static_cast<int>(prm.get_integer("steps"))};
   prm.leave_subsection();
   prm.enter_subsection("output");
   c.output.directory = prm.get("directory");
   prm.leave_subsection();
+}
+
+void extract_calibration(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("calibration");
   auto& cal = c.calibration;
-  cal.variant = prm.get("variant");
+  if (const std::string variant = prm.get("variant"); !variant.empty())
+    cal.variant = parse_setting<Variant>(variant, "calibration/variant");
   cal.groups = dealii::Utilities::split_string_list(prm.get("fit groups"));
   cal.train = parse_tool_loads(prm.get("train loads"), "calibration/train loads");
   cal.test = parse_tool_loads(prm.get("test loads"), "calibration/test loads");
@@ -456,10 +475,21 @@ CaseParameters extract(ParameterHandler& prm) {
   cal.tolerance = prm.get_double("tolerance");
   cal.bound_factor = prm.get_double("bound factor");
   cal.target_damping_ratio = prm.get_double("target damping ratio");
-  cal.model = prm.get("model");
+  cal.model = setting<CalibrationModel>(prm, "model");
   prm.leave_subsection();
   // calibration/variant is checked against mass spring/variants by msfem calibrate, so that
   // `msfem run --set "mass spring/variants=..."` can run any subset.
+}
+
+CaseParameters extract(ParameterHandler& prm) {
+  CaseParameters c;
+  extract_geometry(prm, c);
+  extract_material(prm, c);
+  extract_support(prm, c);
+  extract_loads(prm, c);
+  extract_mass_spring(prm, c);
+  extract_fem_timing_output(prm, c);
+  extract_calibration(prm, c);
   return c;
 }
 
@@ -490,27 +520,6 @@ void load_case(const std::filesystem::path& file, const std::vector<std::string>
 }
 
 }  // namespace
-
-namespace {
-constexpr std::array<std::pair<FemParameters::ErrorEstimate, const char*>, 4> error_estimates = {{
-    {FemParameters::ErrorEstimate::automatic, "auto"},
-    {FemParameters::ErrorEstimate::refine, "refine"},
-    {FemParameters::ErrorEstimate::degree, "degree"},
-    {FemParameters::ErrorEstimate::none, "none"},
-}};
-}  // namespace
-
-const char* error_estimate_name(FemParameters::ErrorEstimate method) {
-  for (const auto& [m, name] : error_estimates)
-    if (m == method) return name;
-  return "auto";
-}
-
-FemParameters::ErrorEstimate error_estimate_from_name(const std::string& name) {
-  for (const auto& [m, n] : error_estimates)
-    if (name == n) return m;
-  throw InputError("fem/error estimate: unknown method '" + name + "'");
-}
 
 std::string ToolLoad::label() const {
   std::ostringstream out;

@@ -1,26 +1,15 @@
 #include "msfem/cases/units.hpp"
 
-#include "msfem/cases/errors.hpp"
+#include "msfem/cases/setting_names.hpp"
 
 namespace msfem::cases {
 
 LengthUnit parse_length_unit(std::string_view name) {
-  if (name == "m") return LengthUnit::metre;
-  if (name == "cm") return LengthUnit::centimetre;
-  if (name == "mm") return LengthUnit::millimetre;
-  throw InputError("unknown length unit '" + std::string(name) + "' (expected m, cm or mm)");
+  return parse_setting<LengthUnit>(name, "length unit");
 }
 
 std::string to_string(LengthUnit unit) {
-  switch (unit) {
-    case LengthUnit::metre:
-      return "m";
-    case LengthUnit::centimetre:
-      return "cm";
-    case LengthUnit::millimetre:
-      return "mm";
-  }
-  throw std::logic_error("to_string: invalid LengthUnit");
+  return name_of(unit);
 }
 
 double metres_per(LengthUnit unit) {

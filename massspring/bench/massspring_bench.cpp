@@ -8,12 +8,12 @@
 #include <map>
 #include <memory>
 
-#include "msfem/massspring/benchmark_cases.hpp"
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/stability.hpp"
-#include "msfem/massspring/stepping_benchmark.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
+#include "msfem/massspring_bench/benchmark_cases.hpp"
+#include "msfem/massspring_bench/stepping_benchmark.hpp"
 #include "obj_surface.hpp"
 
 namespace {

@@ -259,10 +259,9 @@ FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
                                          const FastImplicitOptions& options) {
   // Its kernels know springs, anchors, gravity and loads only: dropping a force field silently
   // would step another model than the one given.
-  if (model.volume() || model.contact())
-    throw ModelError(
-        "fast implicit stepper: the model has volume preservation or tool contact, "
-        "which its kernels do not step; use Integrator");
+  if (!model.fields().empty())
+    throw ModelError("fast implicit stepper: its kernels do not step the model's force fields (" +
+                     model.field_names() + "); use Integrator");
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
   if (options.single_precision &&
       detail::preferred_lanes<float>(true, model.network().num_springs(), model.num_nodes()) == 16)

@@ -160,10 +160,9 @@ FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
                                          const FastStepperOptions& options) {
   // Its kernels know springs, anchors, gravity and loads only: dropping a force field silently
   // would step another model than the one given.
-  if (model.volume() || model.contact())
-    throw ModelError(
-        "fast explicit stepper: the model has volume preservation or tool contact, "
-        "which its kernels do not step; use Integrator");
+  if (!model.fields().empty())
+    throw ModelError("fast explicit stepper: its kernels do not step the model's force fields (" +
+                     model.field_names() + "); use Integrator");
   if (options.single_precision &&
       detail::preferred_lanes<float>(options.allow_avx512, model.network().num_springs(),
                                      model.num_nodes()) == 16)

@@ -1,6 +1,12 @@
 #include "msfem/massspring/force_model.hpp"
 
+#include "msfem/massspring/errors.hpp"
+
 namespace msfem::massspring {
+
+std::shared_ptr<const ForceField> ForceField::scaled(const std::string& group, double) const {
+  throw ModelError("force field: no coefficient group '" + group + "' to scale");
+}
 
 Eigen::VectorXd ForceModel::force(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());

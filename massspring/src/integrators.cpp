@@ -13,38 +13,20 @@ State initial_state(const MassSpringModel& model) {
 }
 
 std::string to_string(IntegratorKind kind) {
-  switch (kind) {
-    case IntegratorKind::explicit_euler:
-      return "explicit_euler";
-    case IntegratorKind::symplectic_euler:
-      return "symplectic_euler";
-    case IntegratorKind::central_difference:
-      return "central_difference";
-    case IntegratorKind::rk4:
-      return "rk4";
-    case IntegratorKind::implicit_euler:
-      return "implicit_euler";
-  }
-  return "unknown";
+  return integrator_table.name(kind);
 }
 
 const std::vector<IntegratorKind>& all_integrators() {
-  static const std::vector<IntegratorKind> kinds = {
-      IntegratorKind::explicit_euler, IntegratorKind::symplectic_euler,
-      IntegratorKind::central_difference, IntegratorKind::rk4, IntegratorKind::implicit_euler};
+  static const std::vector<IntegratorKind> kinds = integrator_table.values();
   return kinds;
 }
 
 std::string integrator_names(const std::string& separator) {
-  std::string names;
-  for (IntegratorKind kind : all_integrators())
-    names += (names.empty() ? "" : separator) + to_string(kind);
-  return names;
+  return integrator_table.names(separator);
 }
 
 IntegratorKind parse_integrator(const std::string& name) {
-  for (IntegratorKind kind : all_integrators())
-    if (to_string(kind) == name) return kind;
+  if (const auto kind = integrator_table.find(name)) return *kind;
   throw ModelError("integrator '" + name + "': unknown (" + integrator_names(", ") + ")");
 }
 

@@ -1,5 +1,6 @@
 #include "msfem/massspring/mass_spring_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -151,31 +152,57 @@ Eigen::Vector3d MassSpringModel::constrained_target(int node) const {
   return (network_.rest_positions.row(node) + prescribed_displacement_.row(node)).transpose();
 }
 
-namespace {
-
-void check_contact_size(const ToolContact& contact, int num_dofs) {
-  if (contact.num_dofs() != num_dofs)
-    throw ModelError("contact: built for " + std::to_string(contact.num_dofs() / 3) +
-                     " nodes, model has " + std::to_string(num_dofs / 3));
+void MassSpringModel::set_field(const std::string& name, std::shared_ptr<const ForceField> field) {
+  if (!field) throw ModelError("force field '" + name + "': none given");
+  if (field->num_dofs() != num_dofs())
+    throw ModelError("force field '" + name + "': built for " +
+                     std::to_string(field->num_dofs() / 3) + " nodes, model has " +
+                     std::to_string(num_nodes()));
+  for (auto& f : fields_)
+    if (f.name == name) {
+      f.field = std::move(field);
+      return;
+    }
+  fields_.push_back({name, std::move(field)});
 }
 
-}  // namespace
+void MassSpringModel::clear_field(const std::string& name) {
+  fields_.erase(std::remove_if(fields_.begin(), fields_.end(),
+                               [&](const NamedField& f) { return f.name == name; }),
+                fields_.end());
+}
+
+const ForceField* MassSpringModel::field(const std::string& name) const {
+  for (const auto& f : fields_)
+    if (f.name == name) return f.field.get();
+  return nullptr;
+}
+
+std::string MassSpringModel::field_names() const {
+  std::string names;
+  for (const auto& f : fields_)
+    names += (names.empty() ? "" : ", ") + f.name;
+  return names;
+}
 
 void MassSpringModel::set_contact(const SphereContactForceField& contact) {
-  check_contact_size(contact, num_dofs());
-  contact_ = std::make_shared<const SphereContactForceField>(contact);
+  set_field(contact_field, std::make_shared<const SphereContactForceField>(contact));
 }
 
 void MassSpringModel::set_contact(const SurfaceContactForceField& contact) {
-  check_contact_size(contact, num_dofs());
-  contact_ = std::make_shared<const SurfaceContactForceField>(contact);
+  set_field(contact_field, std::make_shared<const SurfaceContactForceField>(contact));
+}
+
+const ToolContact* MassSpringModel::contact() const {
+  return dynamic_cast<const ToolContact*>(field(contact_field));
 }
 
 void MassSpringModel::set_volume(const VolumeForceField& volume) {
-  if (volume.num_dofs() != num_dofs())
-    throw ModelError("volume elements: built for " + std::to_string(volume.num_dofs() / 3) +
-                     " nodes, model has " + std::to_string(num_nodes()));
-  volume_ = volume;
+  set_field(volume_field, std::make_shared<const VolumeForceField>(volume));
+}
+
+const VolumeForceField* MassSpringModel::volume() const {
+  return dynamic_cast<const VolumeForceField*>(field(volume_field));
 }
 
 void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
@@ -183,8 +210,8 @@ void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd&
   springs().add_force(x, v, f);
   for (int i = 0; i < num_nodes(); ++i)
     f.segment<3>(3 * i) += network_.masses[i] * gravity_ + external_force_.row(i).transpose();
-  if (contact_) contact_->add_force(x, v, f);
-  if (volume_) volume_->add_force(x, v, f);
+  for (const auto& field : fields_)
+    field.field->add_force(x, v, f);
 }
 
 double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
@@ -193,8 +220,8 @@ double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
   for (int i = 0; i < num_nodes(); ++i)
     energy -= (network_.masses[i] * gravity_ + external_force_.row(i).transpose())
                   .dot(x.segment<3>(3 * i));
-  if (contact_) energy += contact_->potential_energy(x);
-  if (volume_) energy += volume_->potential_energy(x);
+  for (const auto& field : fields_)
+    energy += field.field->potential_energy(x);
   return energy;
 }
 
@@ -202,24 +229,28 @@ void MassSpringModel::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::Ve
                                        const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                                        Linearisation mode) const {
   springs().add_dfdx_product(x, v, dx, df, mode);
-  if (contact_) contact_->add_dfdx_product(x, v, dx, df, mode);
-  if (volume_) volume_->add_dfdx_product(x, v, dx, df, mode);
+  for (const auto& field : fields_)
+    field.field->add_dfdx_product(x, v, dx, df, mode);
 }
 
 void MassSpringModel::add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
                                        Eigen::VectorXd& df) const {
   springs().add_dfdv_product(x, dv, df);
+  for (const auto& field : fields_)
+    field.field->add_dfdv_product(x, dv, df);
 }
 
 void MassSpringModel::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                         Triplets& triplets, Linearisation mode) const {
   springs().add_dfdx_triplets(x, v, triplets, mode);
-  if (contact_) contact_->add_dfdx_triplets(x, v, triplets, mode);
-  if (volume_) volume_->add_dfdx_triplets(x, v, triplets, mode);
+  for (const auto& field : fields_)
+    field.field->add_dfdx_triplets(x, v, triplets, mode);
 }
 
 void MassSpringModel::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const {
   springs().add_dfdv_triplets(x, triplets);
+  for (const auto& field : fields_)
+    field.field->add_dfdv_triplets(x, triplets);
 }
 
 Eigen::VectorXd MassSpringModel::initial_state() const {

@@ -35,19 +35,15 @@ NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
       net.num_nodes(), net.num_anchors(), 1, [&](int a, int) { return net.anchor_node[a]; },
       anchor_start_, anchors_);
   in_contact_set_.assign(net.num_nodes(), 0);
-  // A volume element's energy couples all its nodes, so it is not local to any of them: those
-  // nodes are left to Newton. So is a surface contact's (a triangle's pressure moves its three
-  // nodes together); a node contact is local.
-  in_volume_element_.assign(net.num_nodes(), 0);
-  const bool nodal_contact = dynamic_cast<const SphereContactForceField*>(model.contact());
-  if (model.contact())
-    for (int i : model.contact()->nodes())
-      (nodal_contact ? in_contact_set_ : in_volume_element_)[i] = 1;
-  if (model.volume()) {
-    const Eigen::MatrixX4i& tets = model.volume()->elements().tets;
-    for (Eigen::Index t = 0; t < tets.rows(); ++t)
-      for (int e = 0; e < 4; ++e)
-        in_volume_element_[tets(t, e)] = 1;
+  // A node contact's energy is local to each node, and relaxed here with the springs'. Any other
+  // field's may couple its nodes (a volume element's couples all of it, a surface contact's
+  // triangle its three): those nodes are left to Newton.
+  left_to_newton_.assign(net.num_nodes(), 0);
+  for (const auto& f : model.fields()) {
+    const auto* nodal = dynamic_cast<const SphereContactForceField*>(f.field.get());
+    if (nodal && !nodal_contact_) nodal_contact_ = nodal;
+    for (int i : f.field->nodes())
+      (nodal == nodal_contact_ && nodal ? in_contact_set_ : left_to_newton_)[i] = 1;
   }
 }
 
@@ -82,7 +78,7 @@ double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vecto
     k += net.anchor_stiffness[a] * identity;
   }
   if (in_contact_set_[i]) {
-    const auto& contact = static_cast<const SphereContactForceField&>(*model_.contact());
+    const SphereContactForceField& contact = *nodal_contact_;
     const Eigen::Vector3d w = p - contact.tool().center;
     const double rho = w.norm();
     const double gap = contact.tool().radius - rho;
@@ -123,7 +119,7 @@ int NodeRelaxation::relax(Eigen::VectorXd& x, const Eigen::VectorXd& f, double f
     largest = std::max(largest, f.segment<3>(3 * i).norm());
   std::vector<int> nodes;
   for (int i = 0; i < model_.num_nodes(); ++i)
-    if (!model_.is_constrained(i) && !in_volume_element_[i] && largest > 0.0 &&
+    if (!model_.is_constrained(i) && !left_to_newton_[i] && largest > 0.0 &&
         f.segment<3>(3 * i).norm() >= fraction * largest)
       nodes.push_back(i);
   for (int sweep = 0; sweep < sweeps; ++sweep)

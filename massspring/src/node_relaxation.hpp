@@ -36,8 +36,9 @@ class NodeRelaxation {
   const MassSpringModel& model_;
   std::vector<int> spring_start_, springs_;  // springs at each node (CSR)
   std::vector<int> anchor_start_, anchors_;  // anchors at each node (CSR)
-  std::vector<char> in_contact_set_;         // node is one the tool can touch
-  std::vector<char> in_volume_element_;      // node's energy is not local (volume, surface contact)
+  std::vector<char> in_contact_set_;         // node is one the node contact can touch
+  std::vector<char> left_to_newton_;         // node's energy is not local (volume, surface contact)
+  const SphereContactForceField* nodal_contact_ = nullptr;
 };
 
 }  // namespace msfem::massspring::detail

@@ -101,6 +101,25 @@ VolumeForceField::VolumeForceField(int num_nodes, VolumeElements elements)
                          std::to_string(num_nodes_));
 }
 
+std::vector<int> VolumeForceField::nodes() const {
+  std::vector<char> in(num_nodes_, 0);
+  for (Eigen::Index t = 0; t < elements_.tets.rows(); ++t)
+    for (int k = 0; k < 4; ++k)
+      in[elements_.tets(t, k)] = 1;
+  std::vector<int> list;
+  for (int i = 0; i < num_nodes_; ++i)
+    if (in[i]) list.push_back(i);
+  return list;
+}
+
+std::shared_ptr<const ForceField> VolumeForceField::scaled(const std::string& group,
+                                                           double factor) const {
+  if (group != "volume") return ForceField::scaled(group, factor);
+  auto copy = std::make_shared<VolumeForceField>(*this);
+  copy->set_modulus(elements_.modulus * factor);
+  return copy;
+}
+
 void VolumeForceField::set_modulus(const Eigen::VectorXd& modulus) {
   if (modulus.size() != elements_.num_elements() || !modulus.allFinite() ||
       (modulus.array() < 0.0).any())

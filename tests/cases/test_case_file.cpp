@@ -6,6 +6,7 @@
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/setting_names.hpp"
 #include "msfem/massspring/integrators.hpp"
 
 namespace msfem::cases {
@@ -89,11 +90,11 @@ end
   EXPECT_TRUE(c.loads.tool.directions[1].isApprox(Eigen::Vector3d::UnitX()));
   EXPECT_DOUBLE_EQ(c.loads.tool.depth_m, 0.004);
   EXPECT_EQ(c.loads.tool.curve_depths_m, (std::vector<double>{0.001, 0.002}));
-  EXPECT_EQ(c.mass_spring.variants, (std::vector<std::string>{"three_tier", "skeleton"}));
+  EXPECT_EQ(c.mass_spring.variants, (std::vector<Variant>{Variant::three_tier, Variant::skeleton}));
   ASSERT_EQ(c.mass_spring.group_scales.size(), 2u);
   EXPECT_EQ(c.mass_spring.group_scales[0].first, "tier1_edges");
   EXPECT_DOUBLE_EQ(c.mass_spring.group_scales[1].second, 0.5);
-  EXPECT_EQ(c.mass_spring.inner_tiers, "offset");
+  EXPECT_EQ(c.mass_spring.inner_tiers, massspring::InnerTierMethod::normal_offset);
   EXPECT_EQ(c.fem.degree, 1);
 }
 
@@ -156,7 +157,7 @@ TEST_F(CaseFile, EveryIntegratorMassspringKnowsAndNoOther) {
   const auto p = write("c.prm", "subsection timing\n  set integrator = symplectic_euler\nend\n");
   for (massspring::IntegratorKind kind : massspring::all_integrators()) {
     const std::string name = massspring::to_string(kind);
-    EXPECT_EQ(read_case(p, {"timing/integrator=" + name}).timing.integrator, name);
+    EXPECT_EQ(read_case(p, {"timing/integrator=" + name}).timing.integrator, kind);
   }
   EXPECT_EQ(massspring::to_string(massspring::parse_integrator("central_difference")),
             "central_difference");
@@ -171,7 +172,7 @@ TEST_F(CaseFile, ErrorEstimateMethodsAndTheirLimits) {
   EXPECT_EQ(read_case(p).fem.error_estimate, FemParameters::ErrorEstimate::automatic);
   for (const char* name : {"auto", "refine", "degree", "none"}) {
     const FemParameters fem = read_case(p, {std::string("fem/error estimate=") + name}).fem;
-    EXPECT_STREQ(error_estimate_name(fem.error_estimate), name);
+    EXPECT_EQ(name_of(fem.error_estimate), name);
   }
   // P3 does not exist on tetrahedra: degree + 1 of a P2 reference is refused at once.
   const std::string error = error_of(p, {"fem/degree=2", "fem/error estimate=degree"});

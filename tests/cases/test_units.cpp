@@ -36,7 +36,7 @@ TEST(Units, UnknownNameIsAnInputErrorNamingItAndTheAllowedOnes) {
     } catch (const InputError& error) {
       const std::string message = error.what();
       EXPECT_NE(message.find(std::string("'") + bad + "'"), std::string::npos) << message;
-      EXPECT_NE(message.find("m, cm or mm"), std::string::npos) << message;
+      EXPECT_NE(message.find("(m, cm, mm)"), std::string::npos) << message;
       EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
   }

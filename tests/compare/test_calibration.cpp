@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "msfem/cases/errors.hpp"
-#include "msfem/compare/calibration.hpp"
+#include "msfem/compare/calibration/calibration.hpp"
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
 
@@ -23,7 +23,7 @@ cases::CaseParameters sphere_case() {
   p.loads.tool.depth_m = 0.004;
   p.loads.tool.directions = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(),
                              Eigen::Vector3d(0, -1, 0.5).normalized()};
-  p.mass_spring.variants = {"three_tier"};
+  p.mass_spring.variants = {cases::Variant::three_tier};
   return p;
 }
 
@@ -36,7 +36,7 @@ std::vector<LoadReference> synthetic_references(const Problem& truth, std::vecto
     LoadReference r;
     r.load = {truth.parameters.loads.tool.directions[i], depths[i]};
     r.tool = at_depth(truth.tools[i], depths[i]);
-    BuiltVariant v = build_variant("three_tier", truth, no_mesh, r.tool);
+    BuiltVariant v = build_variant(cases::Variant::three_tier, truth, no_mesh, r.tool);
     const StaticSolution s = solve_variant_static(v);
     r.surface_displacement = s.surface_displacement;
     r.tool_force = s.tool_force;
@@ -68,7 +68,8 @@ CalibrationFit expect_recovers(const cases::CaseParameters& p,
     options.start_factors.push_back(truth[g] * start_off[g]);
   const std::vector<LoadReference> train(refs.begin(), refs.begin() + 2);
   const std::vector<LoadReference> test(refs.begin() + 2, refs.end());
-  const CalibrationFit fit = calibrate(make_problem(p), {}, "three_tier", train, test, options);
+  const CalibrationFit fit =
+      calibrate(make_problem(p), {}, cases::Variant::three_tier, train, test, options);
   EXPECT_EQ(fit.groups.size(), groups.size());
   for (std::size_t g = 0; g < groups.size() && g < fit.groups.size(); ++g) {
     // case_factor: fitted stiffness over the analytic one (the case has no group scales).
@@ -111,7 +112,7 @@ TEST(Calibration, TheVolumeGroupNeedsVolumePreservation) {
   CalibrationOptions options;
   options.groups = {"volume"};
   try {
-    calibrate(problem, {}, "three_tier", refs, {}, options);
+    calibrate(problem, {}, cases::Variant::three_tier, refs, {}, options);
     FAIL() << "the volume group was accepted without volume preservation";
   } catch (const cases::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("volume preservation = true"), std::string::npos)
@@ -125,14 +126,15 @@ TEST(Calibration, RejectsUnknownGroupsAndAnEmptyTrainingSet) {
   CalibrationOptions options;
   options.groups = {"tier1_edges", "no_such_group"};
   try {
-    calibrate(problem, {}, "three_tier", refs, {}, options);
+    calibrate(problem, {}, cases::Variant::three_tier, refs, {}, options);
     FAIL() << "an unknown group was accepted";
   } catch (const cases::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_group"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("tier12_radial"), std::string::npos) << e.what();
   }
   options.groups = {};
-  EXPECT_THROW(calibrate(problem, {}, "three_tier", {}, refs, options), cases::InputError);
+  EXPECT_THROW(calibrate(problem, {}, cases::Variant::three_tier, {}, refs, options),
+               cases::InputError);
 }
 
 TEST(Calibration, StopsAtTheEvaluationLimitAndKeepsTheBestPoint) {
@@ -143,81 +145,13 @@ TEST(Calibration, StopsAtTheEvaluationLimitAndKeepsTheBestPoint) {
   options.groups = {"tier1_edges", "tier2_edges"};
   options.max_evaluations = 4;
   const CalibrationFit fit =
-      calibrate(make_problem(sphere_case()), {}, "three_tier", refs, {}, options);
+      calibrate(make_problem(sphere_case()), {}, cases::Variant::three_tier, refs, {}, options);
   EXPECT_FALSE(fit.converged);
   EXPECT_NE(fit.stop_reason.find("evaluation limit"), std::string::npos) << fit.stop_reason;
   EXPECT_EQ(fit.evaluations, 4);
   // The point kept is the best one evaluated, never worse than the start.
   const double best = *std::min_element(fit.history.begin(), fit.history.end());
   EXPECT_LE(fit.objective_after, std::min(best, fit.objective_before) * (1 + 1e-9));
-}
-
-// A free node of mass m held by six equal springs to fixed nodes of mass m_a on ±x, ±y, ±z: K = 2k
-// I, so every mode has ω² = 2k/m, and C = 2d I with d = 2 r √(k μ), μ = m_a m/(m_a+m), gives the
-// modal ratio ζ = d/(ω m) = r √(2μ/m). The fitted r must also damp a simulated free vibration so.
-TEST(Calibration, DampingFitMatchesTheSixSpringOscillatorAndItsFreeVibration) {
-  const double k = 50.0, m = 0.2, m_a = 0.3, length = 0.01;
-  massspring::SpringNetwork n;
-  n.rest_positions.resize(7, 3);
-  n.rest_positions.setZero();
-  for (int a = 0; a < 3; ++a) {
-    n.rest_positions(1 + 2 * a, a) = length;
-    n.rest_positions(2 + 2 * a, a) = -length;
-  }
-  n.masses = Eigen::VectorXd::Constant(7, m_a);
-  n.masses[0] = m;
-  n.node_damping = Eigen::VectorXd::Zero(7);
-  n.node_group = Eigen::VectorXi::Zero(7);
-  n.node_group_names = {"all"};
-  n.springs.resize(6, 2);
-  for (int s = 0; s < 6; ++s)
-    n.springs.row(s) << 0, s + 1;
-  n.stiffness = Eigen::VectorXd::Constant(6, k);
-  n.damping = Eigen::VectorXd::Zero(6);
-  n.rest_length = Eigen::VectorXd::Constant(6, length);
-  n.spring_group = Eigen::VectorXi::Zero(6);
-  n.spring_group_names = {"s"};
-  massspring::MassSpringModel model(n);
-  for (int node = 1; node < 7; ++node)
-    model.fix_node(node);
-
-  const double target = 0.1;
-  const DampingFit fit = fit_damping(model, model.initial_state(), target);
-  const double omega = std::sqrt(2 * k / m), mu = m_a * m / (m_a + m);
-  EXPECT_NEAR(fit.frequency_hz, omega / (2 * M_PI), 1e-8 * omega);
-  // Every mode is alike here, so a given shape (the Rayleigh-quotient path) agrees.
-  Eigen::VectorXd shape = Eigen::VectorXd::Zero(model.num_dofs());
-  shape[0] = 1e-4;
-  shape[1] = -3e-5;
-  const DampingFit along = fit_damping(model, model.initial_state(), target, shape);
-  EXPECT_NEAR(along.frequency_hz, fit.frequency_hz, 1e-9 * fit.frequency_hz);
-  EXPECT_NEAR(along.case_damping_ratio, fit.case_damping_ratio, 1e-9);
-  EXPECT_NEAR(fit.modal_ratio_per_unit_r, std::sqrt(2 * mu / m), 1e-8);
-  EXPECT_NEAR(fit.case_damping_ratio, target / std::sqrt(2 * mu / m), 1e-8);
-  ASSERT_TRUE(fit.reachable);
-
-  // Free vibration with the fitted damping: the logarithmic decrement gives ζ back.
-  Eigen::VectorXd d(6);
-  for (int s = 0; s < 6; ++s)
-    d[s] = 2 * fit.case_damping_ratio * std::sqrt(k * mu);
-  model.set_damping(d);
-  massspring::State state = massspring::initial_state(model);
-  state.x[0] = 1e-5;  // small: the springs stay linear
-  const double period = 2 * M_PI / omega, dt = period / 2000;
-  massspring::Integrator rk4(massspring::IntegratorKind::rk4);
-  std::vector<double> peaks;
-  double previous = state.x[0], before_previous = state.x[0];
-  for (int step = 0; step < 8000 && peaks.size() < 3; ++step) {
-    rk4.step(model, state, dt);
-    if (previous > before_previous && previous > state.x[0] && previous > 0)
-      peaks.push_back(previous);
-    before_previous = previous;
-    previous = state.x[0];
-  }
-  ASSERT_EQ(peaks.size(), 3u);
-  const double delta = std::log(peaks[0] / peaks[1]);
-  const double zeta = delta / std::sqrt(4 * M_PI * M_PI + delta * delta);
-  EXPECT_NEAR(zeta, target, 0.01 * target);
 }
 
 // The linearised fast path is the same model for small displacements. Data from a three-tier model
@@ -240,11 +174,13 @@ void expect_linear_agrees_and_recovers(cases::CaseParameters p,
   for (const auto& [group, scale] : truth)
     options.groups.push_back(group);
   options.max_evaluations = 1;
-  const CalibrationFit newton = calibrate(problem, {}, "three_tier", refs, {}, options);
+  const CalibrationFit newton =
+      calibrate(problem, {}, cases::Variant::three_tier, refs, {}, options);
   options.linear = true;
   options.max_evaluations = 200;
   options.tolerance = 1e-6;
-  const CalibrationFit linear = calibrate(problem, {}, "three_tier", refs, {}, options);
+  const CalibrationFit linear =
+      calibrate(problem, {}, cases::Variant::three_tier, refs, {}, options);
   for (std::size_t i = 0; i < refs.size(); ++i) {
     EXPECT_GT(newton.before.train[i].rel_l2_error, 0.02);
     // |e_lin − e_newton| ≤ ‖u_lin − u_newton‖ / ‖u_ref‖: the two fields agree to half a percent.

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
-#include "msfem/compare/result_writers.hpp"
+#include "msfem/compare/writers/fields_h5.hpp"
 
 namespace msfem {
 namespace {

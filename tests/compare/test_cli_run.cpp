@@ -6,7 +6,7 @@
 #include <regex>
 
 #include "cli_runner.hpp"
-#include "msfem/compare/result_writers.hpp"
+#include "msfem/compare/writers/fields_h5.hpp"
 
 namespace msfem {
 namespace {

@@ -12,8 +12,8 @@
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
-#include "msfem/compare/fem_error_estimate.hpp"
-#include "msfem/compare/metrics.hpp"
+#include "msfem/compare/pipeline/fem_error_estimate.hpp"
+#include "msfem/compare/pipeline/metrics.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
@@ -70,7 +70,7 @@ TEST(PlanErrorEstimate, SmallProblemsRefineEveryLoad) {
   const auto mesh = kuhn_cube(6);
   const ErrorEstimatePlan plan =
       plan_error_estimate(problem_with(2, Method::automatic), mesh, 1, 4);
-  EXPECT_EQ(plan.method, "refine");
+  EXPECT_EQ(plan.method, Method::refine);
   EXPECT_EQ(plan.loads, 4);
   // Exactly the P2 DoFs of the refined mesh: three per vertex and per edge.
   const auto fine = fem_reference::refine_uniformly(mesh);
@@ -80,7 +80,8 @@ TEST(PlanErrorEstimate, SmallProblemsRefineEveryLoad) {
       for (int b = a + 1; b < 4; ++b)
         edges.insert(std::minmax(fine.tetrahedra(e, a), fine.tetrahedra(e, b)));
   EXPECT_EQ(plan.predicted_dofs, 3 * (std::size_t(fine.num_vertices()) + edges.size()));
-  EXPECT_EQ(plan_error_estimate(problem_with(1, Method::automatic), mesh, 1, 4).method, "degree");
+  EXPECT_EQ(plan_error_estimate(problem_with(1, Method::automatic), mesh, 1, 4).method,
+            Method::degree);
 }
 
 TEST(PlanErrorEstimate, AutoKeepsWithinThreeTimesTheReferencesSolves) {
@@ -88,13 +89,13 @@ TEST(PlanErrorEstimate, AutoKeepsWithinThreeTimesTheReferencesSolves) {
   // Each second solve costs about 2 x 7 = 14 reference solves: 3 x 5 allows one of four loads.
   const ErrorEstimatePlan plan =
       plan_error_estimate(problem_with(2, Method::automatic), mesh, 5, 4);
-  EXPECT_EQ(plan.method, "refine");
+  EXPECT_EQ(plan.method, Method::refine);
   EXPECT_EQ(plan.loads, 1);
   EXPECT_NE(plan.note.find("first 1 of 4"), std::string::npos) << plan.note;
   // 3 x 4 allows none: auto says so rather than exceed its budget; refine asked for runs anyway.
   const ErrorEstimatePlan none =
       plan_error_estimate(problem_with(2, Method::automatic), mesh, 4, 4);
-  EXPECT_EQ(none.method, "none");
+  EXPECT_EQ(none.method, Method::none);
   EXPECT_NE(none.note.find("not estimated"), std::string::npos) << none.note;
   EXPECT_EQ(plan_error_estimate(problem_with(2, Method::refine), mesh, 4, 4).loads, 4);
   EXPECT_EQ(plan_error_estimate(problem_with(2, Method::automatic), mesh, 80, 4).loads, 4);
@@ -104,7 +105,7 @@ TEST(PlanErrorEstimate, ASecondSolveAboveTheCapIsSkippedOrRefused) {
   const auto mesh = kuhn_cube(30);  // about 5 M DoFs refined at P2
   const ErrorEstimatePlan plan =
       plan_error_estimate(problem_with(2, Method::automatic), mesh, 1, 1);
-  EXPECT_EQ(plan.method, "none");
+  EXPECT_EQ(plan.method, Method::none);
   EXPECT_GT(plan.predicted_dofs, max_estimate_dofs);
   try {
     plan_error_estimate(problem_with(2, Method::refine), mesh, 1, 1);
@@ -114,7 +115,7 @@ TEST(PlanErrorEstimate, ASecondSolveAboveTheCapIsSkippedOrRefused) {
               std::string::npos)
         << e.what();
   }
-  EXPECT_EQ(plan_error_estimate(problem_with(2, Method::none), mesh, 1, 1).method, "none");
+  EXPECT_EQ(plan_error_estimate(problem_with(2, Method::none), mesh, 1, 1).method, Method::none);
 }
 
 // The bonded default twin's reference against one two refinements finer (about 3 M DoFs, several
@@ -133,7 +134,7 @@ TEST(FemErrorEstimate, DISABLED_SphereIndentEstimateBracketsTheTruth) {
   for (std::size_t v = 0; v < prescribed.size(); ++v)
     if (!prescribed[v]) compared.push_back(int(v));
   const auto plan = plan_error_estimate(problem, mesh, 4, 1);
-  ASSERT_EQ(plan.method, "refine");
+  ASSERT_EQ(plan.method, Method::refine);
   const FemErrorEstimate estimate =
       estimate_fem_error(problem, mesh, plan, {&coarse}, {compared}, {tool});
   const auto finest = fem_reference::refine_uniformly(fem_reference::refine_uniformly(mesh));

@@ -1,8 +1,9 @@
 #include <gtest/gtest.h>
 
 #include "msfem/cases/case_parameters.hpp"
-#include "msfem/compare/case_run.hpp"
-#include "msfem/compare/variant_run.hpp"
+#include "msfem/cases/setting_names.hpp"
+#include "msfem/compare/pipeline/case_run.hpp"
+#include "msfem/compare/pipeline/variant_run.hpp"
 #include "msfem/massspring/topology_builders.hpp"
 
 namespace msfem::compare {
@@ -78,9 +79,9 @@ TEST(SpringGroups, TheListedGroupsAreWhatEachVariantBuilds) {
   const auto parameters = cases::read_case(std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm");
   const Problem problem = make_problem(parameters);
   const auto mesh = mesh_problem(problem);
-  for (const auto& name : known_variants()) {
-    const BuiltVariant built = build_variant(name, problem, mesh, problem.tools.front());
-    EXPECT_EQ(built.model->network().spring_group_names, spring_groups_of(name)) << name;
+  for (const cases::Variant kind : cases::all_values<cases::Variant>()) {
+    const BuiltVariant built = build_variant(kind, problem, mesh, problem.tools.front());
+    EXPECT_EQ(built.model->network().spring_group_names, spring_groups_of(kind)) << built.name;
   }
 }
 

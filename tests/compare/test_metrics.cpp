@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "msfem/compare/metrics.hpp"
+#include "msfem/compare/pipeline/metrics.hpp"
 
 namespace msfem::compare {
 namespace {

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "msfem/compare/plots.hpp"
+#include "msfem/compare/writers/plots.hpp"
 
 namespace msfem::compare {
 namespace {

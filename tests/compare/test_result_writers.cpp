@@ -9,8 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "msfem/compare/atomic_file.hpp"
-#include "msfem/compare/result_writers.hpp"
+#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/writers/fields_h5.hpp"
+#include "msfem/compare/writers/vtu.hpp"
 
 namespace msfem::compare {
 namespace {

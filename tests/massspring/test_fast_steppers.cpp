@@ -7,8 +7,8 @@
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/stability.hpp"
-#include "msfem/massspring/stepping_benchmark.hpp"
 #include "msfem/massspring/topology_builders.hpp"
+#include "msfem/massspring_bench/stepping_benchmark.hpp"
 
 namespace msfem::massspring {
 namespace {

@@ -10,10 +10,10 @@
 
 #include "icosphere.hpp"
 #include "msfem/massspring/analytic_stiffness.hpp"
-#include "msfem/massspring/benchmark_cases.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/surface_geometry.hpp"
 #include "msfem/massspring/topology_builders.hpp"
+#include "msfem/massspring_bench/benchmark_cases.hpp"
 
 namespace msfem::massspring {
 namespace {

@@ -6,13 +6,27 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "msfem/cases/units.hpp"
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/topology_builders.hpp"
 
 namespace msfem::cases {
+
+/// The mass-spring models msfem builds (their names: setting_names.hpp, as every enumerated
+/// setting).
+enum class Variant { three_tier, single_layer, tet_edges, skeleton };
+/// The FEM reference's linear solver.
+enum class FemSolver { cg_gamg, cg_boomeramg, mumps };
+/// The spring model `msfem calibrate` solves per load.
+enum class CalibrationModel {
+  nonlinear,  ///< static equilibrium by Newton, as msfem run
+  linear      ///< linearised at rest: one Cholesky factorisation per load and evaluation
+};
 
 struct GeometryParameters {
   /// A surface file (relative paths are relative to the case file) or a generator spec such as
@@ -80,15 +94,18 @@ struct LoadParameters {
 /// of that spring and its end masses at r of critical (`msfem calibrate` chooses r for a target
 /// modal damping ratio, docs/calibration.md).
 struct MassSpringParameters {
-  std::vector<std::string> variants = {"three_tier", "single_layer", "tet_edges", "skeleton"};
-  std::string stiffness_model = "lloyd";  ///< lloyd | van_gelder
-  double damping_ratio = 0.5;             ///< spring dampers as a fraction of critical
+  std::vector<Variant> variants = {Variant::three_tier, Variant::single_layer, Variant::tet_edges,
+                                   Variant::skeleton};
+  /// tet_edges' spring stiffness rule (Lloyd et al. 2007 or van Gelder 1998).
+  massspring::TetStiffnessRule stiffness_model = massspring::TetStiffnessRule::lloyd;
+  double damping_ratio = 0.5;  ///< spring dampers as a fraction of critical
   std::vector<std::pair<std::string, double>> group_scales;  ///< "group:factor" overrides
   /// three_tier's prisms and tet_edges' tetrahedra resist volume change (group "volume").
   bool volume_preservation = false;
   double middle_tier_scale = 1.2;
   double inner_tier_scale = 2.0;
-  std::string inner_tiers = "scaled";  ///< scaled | offset (along the inward normal)
+  /// scaled about the centroid (the seed) or offset along the inward normal
+  massspring::InnerTierMethod inner_tiers = massspring::InnerTierMethod::scaling;
   bool inner_diagonals = false;        ///< tier 2 to tier 3 crossing diagonals (not the seed's)
   int skeleton_control_points = 0;     ///< 0: a tenth of the surface vertices, at least 20
   double skeleton_draw_factor = 0.45;  ///< control points drawn toward the centroid by this factor
@@ -106,8 +123,8 @@ struct MassSpringParameters {
 
 struct FemParameters {
   int degree = 2;
-  double cell_size_m = 0.0;        ///< 0: from the surface's mean edge length
-  std::string solver = "cg_gamg";  ///< cg_gamg | cg_boomeramg | mumps
+  double cell_size_m = 0.0;  ///< 0: from the surface's mean edge length
+  FemSolver solver = FemSolver::cg_gamg;
   double relative_tolerance = 1e-10;
   /// Refine the FEM's surface (and volume) within 2 r of each tool, so the reference resolves the
   /// contact patch however coarse the case's surface is.
@@ -118,13 +135,8 @@ struct FemParameters {
   ErrorEstimate error_estimate = ErrorEstimate::automatic;
 };
 
-/// The case-file names of FemParameters::ErrorEstimate ("auto", "refine", "degree", "none").
-const char* error_estimate_name(FemParameters::ErrorEstimate method);
-/// Throws InputError for a name not in error_estimate_name's list.
-FemParameters::ErrorEstimate error_estimate_from_name(const std::string& name);
-
 struct TimingParameters {
-  std::string integrator = "symplectic_euler";
+  massspring::IntegratorKind integrator = massspring::IntegratorKind::symplectic_euler;
   double dt_s = 0.0;  ///< 0: half the estimated stable step
   int steps = 2000;   ///< dynamic steps timed for steps/s
 };
@@ -142,7 +154,7 @@ struct ToolLoad {
 
 /// Defaults of `msfem calibrate` (each has a command-line option that overrides it).
 struct CalibrationParameters {
-  std::string variant;              ///< empty: the first of mass spring/variants
+  std::optional<Variant> variant;   ///< none: the first of mass spring/variants
   std::vector<std::string> groups;  ///< spring groups to fit (empty: all of the variant's)
   std::vector<ToolLoad> train, test;
   double force_weight = 1.0;          ///< J = mean over loads of e_disp² + w e_force²
@@ -150,7 +162,7 @@ struct CalibrationParameters {
   double tolerance = 1e-5;            ///< stop when a step changes every log coefficient by less
   double bound_factor = 100.0;        ///< each factor stays within [1/b, b] of its start
   double target_damping_ratio = 0.5;  ///< of the tool-response mode, for the damping fit
-  std::string model = "nonlinear";    ///< nonlinear (Newton, as msfem run) | linear (at rest)
+  CalibrationModel model = CalibrationModel::nonlinear;
 };
 
 /// Parses "DX,DY,DZ@DEPTH; ..." (depth in metres); throws InputError naming `key` and the entry.

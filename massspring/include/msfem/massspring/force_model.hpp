@@ -2,6 +2,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace msfem::massspring {
@@ -55,6 +57,23 @@ class ForceModel {
   Eigen::SparseMatrix<double> dfdx(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                    Linearisation mode = Linearisation::exact) const;
   Eigen::SparseMatrix<double> dfdv(const Eigen::VectorXd& x) const;
+};
+
+/// A force a MassSpringModel holds beside its springs, gravity and nodal loads (volume
+/// preservation, tool contact, ...): a ForceModel over the model's nodes that also says which nodes
+/// it acts on and which of its coefficients a fit may scale. Fields are immutable once in a model
+/// (copies of the model share them); a changed field is a new one put in its place.
+class ForceField : public ForceModel {
+ public:
+  /// The nodes whose forces this field sets (the static solver's node relaxation leaves them to
+  /// Newton, unless it knows the field).
+  virtual std::vector<int> nodes() const = 0;
+  /// Names of the coefficient groups a fit may scale, each one factor on a set of stiffnesses
+  /// (volume preservation: "volume"); none by default.
+  virtual std::vector<std::string> coefficient_groups() const { return {}; }
+  /// This field with `group`'s coefficients multiplied by `factor`; throws ModelError for a group
+  /// it does not have.
+  virtual std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const;
 };
 
 }  // namespace msfem::massspring

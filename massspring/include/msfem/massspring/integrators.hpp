@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/name_table.hpp"
 
 namespace msfem::massspring {
 
@@ -28,10 +29,19 @@ enum class IntegratorKind {
                        ///< linearisation, solved by Jacobi-preconditioned CG (Baraff & Witkin 1998)
 };
 
-/// "explicit_euler", "symplectic_euler", "central_difference", "rk4", "implicit_euler".
+/// The integrators' names: the one list case files, `msfem sweep --integrators` and
+/// parse_integrator accept.
+inline constexpr NameTable<IntegratorKind, 5> integrator_table{{{
+    {IntegratorKind::explicit_euler, "explicit_euler"},
+    {IntegratorKind::symplectic_euler, "symplectic_euler"},
+    {IntegratorKind::central_difference, "central_difference"},
+    {IntegratorKind::rk4, "rk4"},
+    {IntegratorKind::implicit_euler, "implicit_euler"},
+}}};
+
+/// The kind's name in integrator_table.
 std::string to_string(IntegratorKind kind);
-/// Every integrator, in declaration order: the one list case files, `msfem sweep --integrators`
-/// and parse_integrator accept.
+/// Every integrator, in integrator_table's order.
 const std::vector<IntegratorKind>& all_integrators();
 /// Their names joined by `separator` ("|" gives a deal.II Selection pattern).
 std::string integrator_names(const std::string& separator);

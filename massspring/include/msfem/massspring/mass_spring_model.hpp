@@ -16,10 +16,11 @@
 namespace msfem::massspring {
 
 /// A spring network with its loads and supports: the object a simulator embeds. As a ForceModel it
-/// is the sum of the springs (SpringForceField), gravity m_i g, external nodal forces and, when
-/// active, the tool contact. Supports are nodes whose position is prescribed (fixed = zero
-/// displacement); integrators and solvers hold them at their target and ignore their force rows.
-/// Parameters (k, d, m per group) can be changed between steps; nothing is rebuilt.
+/// is the sum of the springs (SpringForceField), gravity m_i g, external nodal forces and a list of
+/// named force fields (volume preservation, the tool's contact, ...). Supports are nodes whose
+/// position is prescribed (fixed = zero displacement); integrators and solvers hold them at their
+/// target and ignore their force rows. Parameters (k, d, m per group) can be changed between steps;
+/// nothing is rebuilt.
 class MassSpringModel : public ForceModel {
  public:
   /// Validates the network (throws ModelError) and fixes its `fixed_nodes`.
@@ -56,17 +57,33 @@ class MassSpringModel : public ForceModel {
   /// Where a constrained node is held: rest position + prescribed displacement.
   Eigen::Vector3d constrained_target(int node) const;
 
-  // --- tool contact (penalty, frictionless): nodes only, or the surface's triangles ---
+  // --- force fields beyond the springs, summed in list order ---
+  struct NamedField {
+    std::string name;
+    std::shared_ptr<const ForceField> field;
+  };
+  /// Puts `field` in the list under `name`, replacing a field of that name in its place. Throws
+  /// ModelError if it is not built for this model's nodes.
+  void set_field(const std::string& name, std::shared_ptr<const ForceField> field);
+  void clear_field(const std::string& name);
+  /// The field named `name`, or null.
+  const ForceField* field(const std::string& name) const;
+  const std::vector<NamedField>& fields() const { return fields_; }
+  /// The fields' names, comma-separated, for messages.
+  std::string field_names() const;
+
+  // --- the two fields msfem builds, by their names ---
+  /// Tool contact (penalty, frictionless), field "contact": nodes only, or the surface's triangles.
   void set_contact(const SphereContactForceField& contact);
   void set_contact(const SurfaceContactForceField& contact);
-  void clear_contact() { contact_.reset(); }
-  const ToolContact* contact() const { return contact_.get(); }
-
-  // --- volume preservation (the bulk stiffness central springs lack) ---
+  void clear_contact() { clear_field(contact_field); }
+  const ToolContact* contact() const;
+  /// Volume preservation (the bulk stiffness central springs lack), field "volume".
   void set_volume(const VolumeForceField& volume);
-  void clear_volume() { volume_.reset(); }
-  const std::optional<VolumeForceField>& volume() const { return volume_; }
-  std::optional<VolumeForceField>& volume() { return volume_; }
+  void clear_volume() { clear_field(volume_field); }
+  const VolumeForceField* volume() const;
+  static constexpr const char* contact_field = "contact";
+  static constexpr const char* volume_field = "volume";
 
   // --- ForceModel ---
   int num_dofs() const override { return 3 * num_nodes(); }
@@ -110,8 +127,7 @@ class MassSpringModel : public ForceModel {
   Eigen::MatrixX3d external_force_;
   std::vector<char> constrained_;
   Eigen::MatrixX3d prescribed_displacement_;
-  std::shared_ptr<const ToolContact> contact_;  ///< shared by copies: the tool is immutable
-  std::optional<VolumeForceField> volume_;
+  std::vector<NamedField> fields_;  ///< shared by copies: a field is immutable
 };
 
 }  // namespace msfem::massspring

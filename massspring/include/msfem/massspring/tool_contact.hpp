@@ -29,11 +29,10 @@ struct ToolIndentation {
 
 /// A rigid tool's frictionless contact as a force field: what the model's contact slot holds, the
 /// static solver and the integrators see as one more ForceModel, and a haptic loop reads back.
-class ToolContact : public ForceModel {
+class ToolContact : public ForceField {
  public:
   virtual const SphereTool& tool() const = 0;
-  /// The nodes the contact can push.
-  virtual const std::vector<int>& nodes() const = 0;
+  // nodes(): the nodes the contact can push.
   /// A node's contact stiffness (N/m) when the tool presses on it: the node penalty, or for a
   /// surface contact the pressure penalty times a mean node's area. Preconditioners and the node
   /// relaxation use it; the forces come from add_force.
@@ -64,7 +63,7 @@ class SphereContactForceField : public ToolContact {
                          Linearisation mode = Linearisation::exact) const override;
 
   const SphereTool& tool() const override { return tool_; }
-  const std::vector<int>& nodes() const override { return nodes_; }
+  std::vector<int> nodes() const override { return nodes_; }
   double penalty_stiffness() const override { return penalty_; }
 
  private:

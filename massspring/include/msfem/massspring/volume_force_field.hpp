@@ -28,7 +28,7 @@ struct VolumeElements {
 /// this is the continuum's ½ κ (tr ε)² per unit volume: it adds the bulk stiffness that a network
 /// of central springs lacks (its Poisson's ratio is pinned at 1/4 by the Cauchy relations), with
 /// κ = λ(E, ν) − λ(E, 1/4) as the analytic start for a tissue of Poisson's ratio ν.
-class VolumeForceField : public ForceModel {
+class VolumeForceField : public ForceField {
  public:
   /// Throws ModelError for node ids outside [0, num_nodes), a degenerate rest volume, a negative or
   /// non-finite modulus, or inconsistent sizes.
@@ -46,6 +46,12 @@ class VolumeForceField : public ForceModel {
   void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
                          Linearisation mode = Linearisation::exact) const override;
   void add_dfdv_triplets(const Eigen::VectorXd&, Triplets&) const override {}
+
+  /// The nodes of its elements.
+  std::vector<int> nodes() const override;
+  /// "volume": every element's modulus.
+  std::vector<std::string> coefficient_groups() const override { return {"volume"}; }
+  std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const override;
 
   const VolumeElements& elements() const { return elements_; }
   void set_modulus(const Eigen::VectorXd& modulus);  ///< per element, Pa

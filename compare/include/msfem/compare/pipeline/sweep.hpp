@@ -1,0 +1,53 @@
+#pragma once
+// `msfem sweep`: accuracy against speed over variants × resolutions × integrators.
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "msfem/cases/case_parameters.hpp"
+
+namespace msfem::compare {
+
+struct SweepSettings {
+  /// Icosphere levels (generator cases) or target vertex counts (file cases); empty: levels 2-5,
+  /// or 2k, 5k, 9.2k, 20k and 40k vertices capped at the surface's own count.
+  std::vector<int> resolutions;
+  std::vector<massspring::IntegratorKind> integrators = {
+      massspring::IntegratorKind::symplectic_euler, massspring::IntegratorKind::central_difference,
+      massspring::IntegratorKind::rk4, massspring::IntegratorKind::implicit_euler};
+  bool quiet = false;
+};
+
+struct SweepPoint {
+  std::string variant, integrator;
+  int resolution = 0;  ///< level or vertex target, as given
+  int surface_vertices = 0;
+  int nodes = 0, springs = 0;
+  double rel_l2_error = 0.0, reaction_force_rel_error = 0.0;
+  double stable_dt_s = 0.0, steps_per_second = 0.0, realtime_factor = 0.0;
+  double ms_per_60hz_frame = 0.0;
+  /// The resolution's FEM reference's own error (fem/error estimate; none where not estimated)
+  /// and the variant's metrics within 3x of it.
+  std::optional<double> fem_estimated_rel_l2_error, fem_estimated_force_rel_error;
+  std::vector<std::string> not_resolved_by_reference;
+};
+
+struct SweepResult {
+  std::vector<SweepPoint> points;
+  /// Resolutions that could not be run (e.g. the brain simplified below ~2,500 vertices
+  /// self-intersects in its sulci), with the reason; the others are still swept.
+  std::vector<std::pair<int, std::string>> failed_resolutions;
+};
+
+/// Runs the sweep (the FEM once per resolution, through the cache when given). Throws when no
+/// resolution can be run (the first one's error).
+SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
+                      const std::filesystem::path& fem_cache_directory);
+
+nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result);
+std::string sweep_table(const std::vector<SweepPoint>& points);
+
+}  // namespace msfem::compare

@@ -1,0 +1,436 @@
+#include "msfem/compare/calibration/calibration_case.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/surface_generators.hpp"
+#include "msfem/compare/pipeline/case_run.hpp"
+#include "msfem/compare/pipeline/content_hash.hpp"
+#include "msfem/compare/pipeline/fem_cache.hpp"
+#include "msfem/compare/pipeline/fem_run.hpp"
+#include "msfem/fem_reference/volume_mesh.hpp"
+
+namespace msfem::compare {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+cases::Variant resolve_variant(const cases::CaseParameters& p, const CalibrationRequest& request) {
+  const cases::Variant variant =
+      request.variant.value_or(p.calibration.variant.value_or(p.mass_spring.variants.front()));
+  const auto& defined = p.mass_spring.variants;
+  if (std::find(defined.begin(), defined.end(), variant) == defined.end()) {
+    std::string list;
+    for (const auto& v : defined)
+      list += (list.empty() ? "" : ", ") + cases::name_of(v);
+    throw cases::InputError(p.file.string() + ": --variant " + cases::name_of(variant) +
+                            ": the case does not define it (mass spring/variants = " + list + ")");
+  }
+  return variant;
+}
+
+void check_loads(const cases::CaseParameters& p, const std::vector<cases::ToolLoad>& train,
+                 const std::vector<cases::ToolLoad>& test) {
+  const std::string file = p.file.string();
+  if (train.empty())
+    throw cases::InputError(file +
+                            ": calibration: the training set is empty (give --train or set "
+                            "calibration/train loads)");
+  for (const auto& a : test)
+    for (const auto& b : train)
+      if (a.same_as(b))
+        throw cases::InputError(file + ": calibration: load " + a.label() +
+                                " is both a training and a held-out load (held-out loads must "
+                                "differ from the training ones)");
+  auto check_unique = [&](const std::vector<cases::ToolLoad>& loads, const char* what) {
+    for (std::size_t i = 0; i < loads.size(); ++i)
+      for (std::size_t j = i + 1; j < loads.size(); ++j)
+        if (loads[i].same_as(loads[j]))
+          throw cases::InputError(file + ": calibration: load " + loads[i].label() +
+                                  " appears twice in the " + what + " set");
+  };
+  check_unique(train, "training");
+  check_unique(test, "held-out");
+}
+
+// Before any solve: every group to fit is one the variant has.
+void check_fit_groups(const cases::CaseParameters& p, cases::Variant variant,
+                      const std::vector<std::string>& groups) {
+  const std::vector<std::string> known = spring_groups_of(variant, p);
+  for (const auto& g : groups)
+    if (std::find(known.begin(), known.end(), g) == known.end()) {
+      std::string list;
+      for (const auto& k : known)
+        list += (list.empty() ? "" : ", ") + k;
+      throw cases::InputError(p.file.string() + ": calibration: variant " +
+                              cases::name_of(variant) + " has no group '" + g +
+                              "' (its groups: " + list +
+                              (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
+    }
+}
+
+// The case with its tool enabled at every direction the loads use, as deep as the deepest load
+// (make_problem checks that depth against the model's size).
+Problem calibration_problem(cases::CaseParameters p, const std::vector<cases::ToolLoad>& loads) {
+  auto& tool = p.loads.tool;
+  tool.enabled = true;
+  tool.directions.clear();
+  tool.depth_m = 0.0;
+  for (const auto& l : loads) {
+    tool.depth_m = std::max(tool.depth_m, l.depth_m);
+    if (std::none_of(tool.directions.begin(), tool.directions.end(),
+                     [&](const Eigen::Vector3d& d) { return (d - l.direction).norm() < 1e-9; }))
+      tool.directions.push_back(l.direction);
+  }
+  return make_problem(p);
+}
+
+ToolPlacement placement_of(const Problem& problem, const cases::ToolLoad& load) {
+  const auto& directions = problem.parameters.loads.tool.directions;
+  for (std::size_t i = 0; i < directions.size(); ++i)
+    if ((directions[i] - load.direction).norm() < 1e-9)
+      return at_depth(problem.tools[i], load.depth_m);
+  throw std::logic_error("calibration: no tool placed for load " + load.label());
+}
+
+std::string load_key(const std::string& problem_key, const cases::ToolLoad& load) {
+  ContentHash h;
+  h.text("msfem-calibration-load-1").text(problem_key).matrix(load.direction).number(load.depth_m);
+  return h.hex();
+}
+
+// The reference's own error at the freshly solved loads (as many as fem/error estimate's plan
+// allows), then each fresh load stored in the cache with its estimate.
+void estimate_and_store(CaseCalibration& c, std::vector<LoadReference>& references,
+                        const std::vector<std::optional<FemCacheEntry>>& cached,
+                        const std::vector<FemSolution>& solved, const ErrorEstimatePlan& plan,
+                        const std::string& problem_key, const CalibrationRequest& request,
+                        const Progress& progress) {
+  std::vector<std::size_t> fresh;
+  std::vector<const FemSolution*> solutions;
+  std::vector<std::vector<int>> compared;
+  std::vector<std::optional<ToolPlacement>> tools;
+  for (std::size_t i = 0; i < references.size(); ++i)
+    if (!cached[i]) {
+      fresh.push_back(i);
+      solutions.push_back(&solved[solutions.size()]);
+      compared.push_back(references[i].compared_vertices);
+      tools.emplace_back(references[i].tool);
+    }
+  if (plan.method != cases::FemParameters::ErrorEstimate::none && !fresh.empty())
+    progress.stage("estimating the reference's own error (" + plan.note + ")");
+  const FemErrorEstimate estimate =
+      estimate_fem_error(c.problem, c.mesh, plan, solutions, compared, tools);
+  for (std::size_t k = 0; k < fresh.size(); ++k) {
+    LoadReference& r = references[fresh[k]];
+    r.fem_error = estimate.loads[k];
+    if (!request.fem_cache_directory) continue;
+    FemErrorEstimate one = estimate;
+    one.loads = {estimate.loads[k]};
+    store_fem_cache(*request.fem_cache_directory, load_key(problem_key, r.load),
+                    {c.mesh, solved[k], {}, {}, one});
+  }
+}
+
+// Two directions can pick the same surface vertex: a held-out load pressed where and as deep as a
+// training load is the same load, and would check the fit on what it was fitted to.
+void check_distinct_vertices(const Problem& problem, const std::vector<cases::ToolLoad>& train,
+                             const std::vector<cases::ToolLoad>& test) {
+  for (const auto& a : test)
+    for (const auto& b : train) {
+      const ToolPlacement pa = placement_of(problem, a), pb = placement_of(problem, b);
+      if (pa.vertex == pb.vertex && std::abs(a.depth_m - b.depth_m) < 1e-12)
+        throw cases::InputError(problem.parameters.file.string() + ": calibration: held-out load " +
+                                a.label() + " presses the same surface vertex (" +
+                                std::to_string(pa.vertex) + ") as deep as training load " +
+                                b.label() + ": it is the same load");
+    }
+}
+
+// The FEM of every load, from the cache where it is there.
+void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& train,
+                      const std::vector<cases::ToolLoad>& test, const CalibrationRequest& request,
+                      const Progress& progress) {
+  const Problem& problem = c.problem;
+  const std::string problem_key = fem_cache_key(problem, {});
+  std::vector<cases::ToolLoad> all = train;
+  all.insert(all.end(), test.begin(), test.end());
+  std::vector<std::optional<FemCacheEntry>> cached(all.size());
+  bool have_mesh = false;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (request.fem_cache_directory)
+      cached[i] = load_fem_cache(*request.fem_cache_directory, load_key(problem_key, all[i]));
+    if (cached[i] && !have_mesh) {
+      c.mesh = cached[i]->mesh;  // every load shares one mesh, refined near every tool
+      have_mesh = true;
+    }
+  }
+  if (!have_mesh) {
+    progress.stage("meshing the volume (Gmsh), refined near all " +
+                   std::to_string(problem.tools.size()) + " tool positions");
+    c.mesh = mesh_problem(problem, problem.tools);
+  }
+  check_no_rigid_motion(problem, c.mesh, placement_of(problem, all.front()));
+  const int fresh = static_cast<int>(std::count(cached.begin(), cached.end(), std::nullopt));
+  // Decided (and refused, for a method that cannot run) before the first solve.
+  const ErrorEstimatePlan plan = plan_error_estimate(problem, c.mesh, fresh, fresh);
+  const auto start = Clock::now();
+  std::vector<FemSolution> solved;  // the fresh loads', in load order, for the estimate
+  std::vector<LoadReference> references;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    LoadReference r;
+    r.load = all[i];
+    r.tool = placement_of(problem, all[i]);
+    const std::vector<bool> prescribed = prescribed_surface_vertices(problem, r.tool);
+    for (std::size_t v = 0; v < prescribed.size(); ++v)
+      if (!prescribed[v]) r.compared_vertices.push_back(static_cast<int>(v));
+    if (cached[i]) {
+      ++c.fem_from_cache;
+      r.surface_displacement = cached[i]->solution.surface_displacement;
+      r.tool_force = cached[i]->solution.tool_force;
+      if (!cached[i]->error_estimate.loads.empty())
+        r.fem_error = cached[i]->error_estimate.loads.front();
+    } else {
+      solved.push_back(solve_fem(problem, c.mesh, r.tool));
+      ++c.fem_solves;
+      r.surface_displacement = solved.back().surface_displacement;
+      r.tool_force = solved.back().tool_force;
+    }
+    references.push_back(std::move(r));
+    progress.advance("FEM reference per load (" + std::to_string(c.fem_from_cache) + " cached)",
+                     static_cast<int>(i + 1), static_cast<int>(all.size()), seconds_since(start));
+  }
+  estimate_and_store(c, references, cached, solved, plan, problem_key, request, progress);
+  for (std::size_t i = 0; i < references.size(); ++i)
+    (i < train.size() ? c.train : c.test).push_back(std::move(references[i]));
+  c.fem_time_s = seconds_since(start);
+}
+
+// Fitted errors within 3x of the reference's own at their load: the fit cannot be judged there.
+void note_unresolved_loads(CaseCalibration& c) {
+  std::string list;
+  auto check = [&](const std::vector<LoadReference>& references,
+                   const std::vector<LoadErrors>& errors) {
+    for (std::size_t i = 0; i < references.size() && i < errors.size(); ++i) {
+      const LoadErrorEstimate& e = references[i].fem_error;
+      if (within_reference_error(errors[i].rel_l2_error, e.rel_l2_error) ||
+          within_reference_error(errors[i].reaction_force_rel_error, e.force_rel_error))
+        list += (list.empty() ? "" : ", ") + references[i].load.label();
+    }
+  };
+  check(c.train, c.fit.after.train);
+  check(c.test, c.fit.after.test);
+  if (!list.empty())
+    c.notes.push_back("not resolved by this reference: after the fit, the error at " + list +
+                      " is within 3x of the FEM's own estimated error (fem.error_estimate); a "
+                      "finer fem/cell size is needed to judge the fit there");
+}
+
+// Group scales of the calibrated case: the case's own entries with the fitted groups replaced.
+std::vector<std::pair<std::string, double>> calibrated_group_scales(
+    const cases::CaseParameters& p, const std::vector<FittedGroup>& fitted) {
+  std::vector<std::pair<std::string, double>> scales;
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (std::none_of(fitted.begin(), fitted.end(),
+                     [&](const FittedGroup& f) { return f.group == group; }))
+      scales.emplace_back(group, factor);
+  for (const auto& f : fitted)
+    scales.emplace_back(f.group, f.case_factor);
+  return scales;
+}
+
+std::string group_scales_assignment(const std::vector<std::pair<std::string, double>>& scales) {
+  std::string text = "mass spring/group scales=";
+  char buffer[64];
+  for (std::size_t i = 0; i < scales.size(); ++i) {
+    std::snprintf(buffer, sizeof buffer, "%.10g", scales[i].second);
+    text += (i ? ", " : "") + scales[i].first + ":" + buffer;
+  }
+  return text;
+}
+
+VariantOnTest mean_on(const std::string& name, bool calibrated,
+                      const std::vector<LoadErrors>& errors) {
+  VariantOnTest v{name, calibrated, 0.0, 0.0};
+  for (const auto& e : errors) {
+    v.mean_rel_l2_error += e.rel_l2_error / errors.size();
+    v.mean_reaction_force_rel_error += e.reaction_force_rel_error / errors.size();
+  }
+  return v;
+}
+
+// Below this many tool nodes the report warns (see LoadErrors::tool_patch_nodes).
+constexpr int min_tool_patch_nodes = 3;
+
+// "load (N nodes), ..." for every training or held-out load whose tool patch is that small.
+std::string loads_with_few_tool_nodes(const ErrorsOnLoads& errors) {
+  std::string list;
+  for (const auto* set : {&errors.train, &errors.test})
+    for (const LoadErrors& e : *set)
+      if (e.tool_patch_nodes < min_tool_patch_nodes)
+        list += (list.empty() ? "" : ", ") + e.load + " (" + std::to_string(e.tool_patch_nodes) +
+                (e.tool_patch_nodes == 1 ? " node)" : " nodes)");
+  return list;
+}
+
+// The fit's settings from the case and the request, checked before anything is solved.
+void set_options(CaseCalibration& c, const cases::CaseParameters& parameters,
+                 const CalibrationRequest& request) {
+  const auto& defaults = parameters.calibration;
+  // The linearised statics hold the tool as a prescribed patch; a frictionless tool would be
+  // fitted against loads it does not apply. The nonlinear fit presses by contact as msfem run does.
+  if (parameters.loads.tool.mode == cases::ToolParameters::Mode::contact &&
+      defaults.model == cases::CalibrationModel::linear)
+    throw cases::InputError(parameters.file.string() +
+                            ": calibration/model = linear holds the tool as a bonded patch, but "
+                            "loads/tool/mode = contact: use calibration/model = nonlinear (the "
+                            "default) to calibrate in contact");
+  check_group_names(parameters);
+  c.options.groups = request.groups.value_or(defaults.groups);
+  check_fit_groups(parameters, c.variant, c.options.groups);
+  c.options.force_weight = defaults.force_weight;
+  c.options.max_evaluations = defaults.max_evaluations;
+  c.options.tolerance = defaults.tolerance;
+  c.options.bound_factor = defaults.bound_factor;
+  c.target_damping_ratio = defaults.target_damping_ratio;
+  c.options.linear = defaults.model == cases::CalibrationModel::linear;
+}
+
+void fit(CaseCalibration& c, const Progress& progress) {
+  progress.stage("fitting " + cases::name_of(c.variant) + " (BOBYQA, at most " +
+                 std::to_string(c.options.max_evaluations) + " evaluations of " +
+                 std::to_string(c.train.size()) + " static solves)");
+  const auto fit_start = Clock::now();
+  CalibrationOptions options = c.options;
+  options.on_evaluation = [&](int evaluation, double) {
+    if (evaluation % 20 == 0)
+      progress.advance("calibration evaluations (upper bound)", evaluation, options.max_evaluations,
+                       seconds_since(fit_start));
+  };
+  c.fit = calibrate(c.problem, c.mesh, c.variant, c.train, c.test, options);
+  if (!c.fit.converged) c.notes.push_back("the optimiser did not converge: " + c.fit.stop_reason);
+  if (!c.fit.refit_reason.empty()) c.notes.push_back(c.fit.refit_reason);
+  if (const std::string few = loads_with_few_tool_nodes(c.fit.before); !few.empty())
+    c.notes.push_back(
+        "the tool holds fewer than " + std::to_string(min_tool_patch_nodes) + " surface nodes of " +
+        cases::name_of(c.variant) + " at " + few +
+        ": such a patch's force grows about linearly with depth while the FEM's resolved contact "
+        "grows faster, so no stiffness fits every depth; only a surface fine enough under the "
+        "tool for the patch to grow with depth can follow it");
+}
+
+// The calibrated case as calibrated.prm states it, re-solved from the file's values: it checks
+// that the file reproduces the fit, and gives the equilibrium the damping fit linearises about.
+void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& parameters,
+                           const CalibrationRequest& request) {
+  c.calibrated_overrides = request.overrides;
+  c.calibrated_overrides.push_back("calibration/variant=" + cases::name_of(c.variant));
+  Problem calibrated = c.problem;
+  calibrated.parameters.mass_spring.group_scales =
+      calibrated_group_scales(parameters, c.fit.groups);
+  c.calibrated_overrides.push_back(
+      group_scales_assignment(calibrated.parameters.mass_spring.group_scales));
+  BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
+  Eigen::VectorXd x;
+  const LoadErrors check =
+      evaluate_load(built, c.train.front(), x, c.problem.parameters.loads.tool.path_step_m);
+  c.nonlinear_check = check;
+  if (c.options.linear)
+    c.notes.push_back(
+        "the fit used the spring model linearised at rest; the nonlinear model (as "
+        "msfem run solves it) with the fitted values gives rel_l2_error " +
+        std::to_string(check.rel_l2_error) + " and reaction_force_rel_error " +
+        std::to_string(check.reaction_force_rel_error) + " on " + check.load);
+  else if (std::abs(check.rel_l2_error - c.fit.after.train.front().rel_l2_error) >
+           1e-6 * std::max(1.0, check.rel_l2_error))
+    c.notes.push_back("calibrated.prm re-solved gives rel_l2_error " +
+                      std::to_string(check.rel_l2_error) + " on " + check.load +
+                      " where the fit had " +
+                      std::to_string(c.fit.after.train.front().rel_l2_error));
+  // The mode that settles after a press: the static deflection under the first training load.
+  c.damping = massspring::fit_damping(*built.model, x, c.target_damping_ratio,
+                                      x - built.model->initial_state());
+  if (c.damping.reachable) {
+    char ratio[64];
+    std::snprintf(ratio, sizeof ratio, "%.6g", c.damping.case_damping_ratio);
+    c.calibrated_overrides.push_back(std::string("mass spring/damping ratio=") + ratio);
+  } else {
+    c.notes.push_back(
+        "damping: spring dampers cannot give the tool-response mode the target ratio");
+  }
+  if (!cases::is_surface_generator(parameters.geometry.source))
+    c.calibrated_overrides.push_back(
+        "geometry/source=" + std::filesystem::absolute(parameters.geometry.source).string());
+  c.lumped_mass_kg = built.model->network().masses.sum();
+  c.fem_mass_kg = parameters.material.density_kg_per_m3 * fem_reference::volume(c.mesh);
+}
+
+// The case's other variants, as the case has them, on the held-out loads with the fit's model
+// (nonlinear or linearised), ranked with the calibrated one.
+void compare_on_held_out_loads(CaseCalibration& c, const cases::CaseParameters& parameters,
+                               const CalibrationRequest& request, const Progress& progress) {
+  c.variants.push_back(mean_on(cases::name_of(c.variant), true, c.fit.after.test));
+  if (request.compare_variants && !c.test.empty()) {
+    for (const cases::Variant kind : parameters.mass_spring.variants) {
+      if (kind == c.variant) continue;
+      const std::string name = cases::name_of(kind);
+      progress.stage("held-out loads on " + name + " (as the case has it) for comparison");
+      BuiltVariant other = build_variant(kind, c.problem, c.mesh, c.test.front().tool);
+      std::vector<LoadErrors> errors;
+      try {
+        for (const auto& r : c.test) {
+          Eigen::VectorXd xo;
+          errors.push_back(
+              c.options.linear
+                  ? evaluate_load_linear(other, r)
+                  : evaluate_load(other, r, xo, c.problem.parameters.loads.tool.path_step_m));
+        }
+      } catch (const std::runtime_error& e) {
+        // A comparison only: say so and go on, the calibration itself stands.
+        c.notes.push_back("comparison variant " + name + " left out: " + e.what());
+        continue;
+      }
+      c.variants.push_back(mean_on(name, false, errors));
+    }
+  }
+  std::sort(c.variants.begin(), c.variants.end(),
+            [](const auto& a, const auto& b) { return a.mean_rel_l2_error < b.mean_rel_l2_error; });
+}
+
+}  // namespace
+
+CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
+                               const CalibrationRequest& request) {
+  const auto start = Clock::now();
+  const Progress progress(request.quiet);
+  CaseCalibration c;
+  c.variant = resolve_variant(parameters, request);
+  const std::vector<cases::ToolLoad> train = request.train.value_or(parameters.calibration.train);
+  const std::vector<cases::ToolLoad> test = request.test.value_or(parameters.calibration.test);
+  check_loads(parameters, train, test);
+  set_options(c, parameters, request);
+
+  progress.stage("loading the surface and placing the tool at every load's position");
+  std::vector<cases::ToolLoad> all = train;
+  all.insert(all.end(), test.begin(), test.end());
+  c.problem = calibration_problem(parameters, all);
+  check_distinct_vertices(c.problem, train, test);
+  check_variants_fit(c.problem);
+  solve_references(c, train, test, request, progress);
+
+  fit(c, progress);
+  state_calibrated_case(c, parameters, request);
+  compare_on_held_out_loads(c, parameters, request, progress);
+  if (c.test.empty()) c.notes.push_back("no held-out loads: the fit is not checked on new loads");
+  note_unresolved_loads(c);
+  c.total_time_s = seconds_since(start);
+  return c;
+}
+
+}  // namespace msfem::compare

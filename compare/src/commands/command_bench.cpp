@@ -1,0 +1,113 @@
+// msfem bench massspring: steps per second of the mass-spring steppers on the seed sphere, the
+// brain and ten times the brain, against the naive scalar loop run in the same process.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include "msfem/cases/surface_io.hpp"
+#include "msfem/compare/commands/commands.hpp"
+#include "msfem/compare/commands/options.hpp"
+#include "msfem/massspring_bench/benchmark_cases.hpp"
+
+namespace msfem::compare {
+namespace {
+
+constexpr const char* kBrainFile = "brain_icbm152_lh_9177_mm.obj";
+
+nlohmann::json to_json(const massspring::BenchmarkCase& c,
+                       const massspring::SteppingBenchmarkResult& r,
+                       const massspring::SteppingBenchmarkOptions& options) {
+  return {{"name", c.name},
+          {"description", c.description},
+          {"nodes", r.nodes},
+          {"springs", r.springs},
+          {"threads", r.threads},
+          {"explicit_steps_per_second", r.explicit_steps_per_second},
+          {"naive_steps_per_second", r.naive_steps_per_second},
+          {"speedup_over_naive", r.naive_steps_per_second > 0.0
+                                     ? r.explicit_steps_per_second / r.naive_steps_per_second
+                                     : 0.0},
+          {"implicit_steps_per_second", r.implicit_steps_per_second},
+          {"implicit_mean_cg_iterations", r.implicit_mean_cg_iterations},
+          {"explicit_dt_s", r.explicit_dt},
+          {"implicit_dt_s", options.implicit_dt},
+          {"warnings", c.network.warnings}};
+}
+
+int bench_massspring(const Options& options) {
+  const bool json = options.flag("json");
+  const std::filesystem::path mesh_dir =
+      options.value("mesh-dir").value_or(std::string(MSFEM_DEFAULT_CASES_DIR) + "/data");
+  const std::filesystem::path brain_path = mesh_dir / kBrainFile;
+
+  std::optional<Eigen::MatrixX3d> brain_vertices;
+  std::optional<Eigen::MatrixX3i> brain_triangles;
+  if (std::filesystem::exists(brain_path)) {
+    const cases::Surface brain = cases::read_surface(brain_path, cases::LengthUnit::millimetre);
+    brain_vertices = brain.vertices;
+    brain_triangles = brain.triangles;
+  } else {
+    std::cerr << "msfem bench: " << brain_path.string()
+              << " not found; brain_scale uses a geodesic sphere of the same size\n";
+  }
+
+  massspring::SteppingBenchmarkOptions bench_options;
+  bench_options.threads = static_cast<int>(options.integer("threads", 2));
+  bench_options.samples = static_cast<int>(options.integer("samples", 5));
+  bench_options.single_precision = options.flag("float");
+  if (const auto seconds = options.value("seconds"))
+    bench_options.seconds_per_sample = std::stod(*seconds);
+  if (bench_options.threads < 1) throw std::invalid_argument("option --threads must be >= 1");
+  if (bench_options.samples < 1) throw std::invalid_argument("option --samples must be >= 1");
+  if (!(bench_options.seconds_per_sample > 0.0))
+    throw std::invalid_argument("option --seconds must be > 0");
+
+  nlohmann::json cases_json = nlohmann::json::array();
+  for (const auto& c :
+       massspring::benchmark_cases(brain_vertices, brain_triangles, !options.flag("no-10x"))) {
+    const auto result = massspring::run_benchmark_case(c, bench_options);
+    cases_json.push_back(to_json(c, result, bench_options));
+    if (!json)
+      std::printf(
+          "%-12s %8d nodes %9d springs  explicit %9.0f steps/s  naive %8.0f steps/s "
+          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)\n",
+          c.name.c_str(), result.nodes, result.springs, result.explicit_steps_per_second,
+          result.naive_steps_per_second,
+          result.naive_steps_per_second > 0.0
+              ? result.explicit_steps_per_second / result.naive_steps_per_second
+              : 0.0,
+          result.implicit_steps_per_second, result.implicit_mean_cg_iterations);
+  }
+  if (json) {
+    const nlohmann::json report = {{"benchmark", "massspring"},
+                                   {"hardware_threads", std::thread::hardware_concurrency()},
+                                   {"threads", bench_options.threads},
+                                   {"single_precision", bench_options.single_precision},
+                                   {"seconds_per_sample", bench_options.seconds_per_sample},
+                                   {"samples", bench_options.samples},
+                                   {"statistic", "median steps per second after warm-up"},
+                                   {"cases", cases_json}};
+    std::cout << report.dump(2) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int bench_command(const Arguments& args) {
+  const Options options(args, {"json", "float", "no-10x"},
+                        {"mesh-dir", "threads", "samples", "seconds"});
+  if (options.positional().size() != 1)
+    throw std::invalid_argument(
+        "usage: msfem bench massspring [--json] [--mesh-dir DIR] [--threads N] [--samples N] "
+        "[--seconds S] [--float] [--no-10x]");
+  const std::string& what = options.positional().front();
+  if (what == "massspring") return bench_massspring(options);
+  throw std::invalid_argument("bench '" + what + "': unknown (massspring)");
+}
+
+}  // namespace msfem::compare

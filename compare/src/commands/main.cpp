@@ -1,0 +1,120 @@
+// msfem: mass-spring models of soft tissue measured against a linear-elastic FEM reference.
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/compare/commands/commands.hpp"
+
+namespace {
+
+struct CommandEntry {
+  const char* name;
+  int (*run)(const msfem::compare::Arguments&);
+  const char* usage;
+};
+
+const std::vector<CommandEntry>& commands() {
+  using namespace msfem::compare;
+  static const std::vector<CommandEntry> table = {
+      {"run", run_command,
+       "run CASE.prm [--out DIR] [--set SECTION/KEY=VALUE]... [--quiet] [--json] [--no-curve]\n"
+       "          [--no-timing] [--no-cache]\n"
+       "      the FEM and every mass-spring variant on the case; summary.json, report.md, VTU, "
+       "HDF5\n"
+       "      (--no-curve: no force-depth curve; --no-timing: no dynamics timed; --no-cache: "
+       "solve\n"
+       "      the FEM even if <output directory>/.fem-cache holds it)"},
+      {"sweep", sweep_command,
+       "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
+       "          [--quiet] [--json]\n"
+       "      variants x resolutions x integrators: sweep.json, table and Pareto plot"},
+      {"regress", regress_command,
+       "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]... [--quiet]\n"
+       "      compare runs with committed baselines; exit 1 on a worse metric or field, a missing\n"
+       "      or stale baseline, or a non-finite value"},
+      {"calibrate", calibrate_command,
+       "calibrate CASE.prm [--variant NAME] [--fit GROUP[,GROUP...]] [--train LOADS] [--test "
+       "LOADS]\n"
+       "          [--out DIR] [--set K=V]... [--max-evaluations N] [--strict] [--json] "
+       "[--no-compare]\n"
+       "          [--no-cache] [--quiet]\n"
+       "      fit spring-group stiffness to the FEM on training loads (DX,DY,DZ@DEPTH;...), check\n"
+       "      on held-out loads; calibration.json, report.md, calibrated.prm"},
+      {"params", params_command, "params\n      print the whole case-file language"},
+      {"mesh-info", mesh_info_command,
+       "mesh-info FILE [--unit m|cm|mm] [--json] [--no-self-intersections]\n"
+       "            mesh-info --generate icosphere:LEVEL[:RADIUS_M] | ellipsoid:LEVEL:A:B:C\n"
+       "      counts, volume, bounding box, genus and every defect; exit 1 on a defect"},
+      {"simplify", simplify_command,
+       "simplify IN OUT --vertices N [--unit m|cm|mm] [--smooth ITERATIONS] [--binary]\n"
+       "      edge-collapse to exactly N vertices (then Taubin smoothing), written in IN's unit"},
+      {"bench", bench_command,
+       "bench massspring [--json] [--mesh-dir DIR] [--threads N] [--samples N] [--seconds S]\n"
+       "          [--float] [--no-10x]\n"
+       "      stepping speed of the mass-spring models"},
+      {"verify", verify_command,
+       "verify [--json] [--no-locking]\n      the FEM reference against closed-form solutions"},
+  };
+  return table;
+}
+
+void print_usage(std::FILE* out) {
+  std::fprintf(out, "usage: msfem COMMAND [ARGS]\n\ncommands:\n");
+  for (const auto& c : commands())
+    std::fprintf(out, "  %s\n", c.usage);
+}
+
+bool wants_help(const std::vector<std::string>& args) {
+  for (const auto& a : args)
+    if (a == "--help" || a == "-h") return true;
+  return false;
+}
+
+// A result a script cannot read is not a success: a full disk or a closed pipe on standard output
+// turns exit 0 into 1.
+int finish(const std::string& name, int code) {
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::cerr << "msfem " << name << ": failed: cannot write to standard output\n";
+    return code == 0 ? 1 : code;
+  }
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    print_usage(args.empty() ? stderr : stdout);
+    return args.empty() ? 2 : 0;
+  }
+  const std::string name = args[0];
+  args.erase(args.begin());
+  for (const auto& c : commands()) {
+    if (name != c.name) continue;
+    if (wants_help(args)) {
+      std::printf("usage: msfem %s\n", c.usage);
+      return finish(name, 0);
+    }
+    try {
+      return finish(name, c.run(args));
+    } catch (const msfem::cases::InputError& e) {
+      std::cerr << "msfem " << name << ": error: " << e.what() << '\n';
+      return 2;
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "msfem " << name << ": error: " << e.what() << '\n';
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "msfem " << name << ": failed: " << e.what() << '\n';
+      return 1;
+    }
+  }
+  std::cerr << "msfem: unknown command '" << name << "'\n";
+  print_usage(stderr);
+  return 2;
+}

@@ -1,0 +1,316 @@
+#include "msfem/compare/pipeline/problem.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface_generators.hpp"
+#include "msfem/cases/surface_io.hpp"
+#include "msfem/cases/surface_refinement.hpp"
+#include "msfem/cases/surface_simplification.hpp"
+#include "msfem/cases/surface_validation.hpp"
+#include "msfem/cases/units.hpp"
+#include "msfem/fem_reference/supports_and_loads.hpp"
+
+namespace msfem::compare {
+namespace {
+
+// A surface in millimetres read as metres is a 100 m organ that meshes and solves without error:
+// say so (on stderr and in the report) when the size is outside what an organ or a tissue sample
+// can be.
+void warn_if_not_organ_sized(const cases::CaseParameters& p, const cases::Surface& s,
+                             std::vector<std::string>& notes) {
+  const Eigen::Matrix<double, 2, 3> box = cases::bounding_box(s);
+  const double size = (box.row(1) - box.row(0)).maxCoeff();
+  if (size >= 1e-3 && size <= 1.0) return;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the surface spans %.3g m (geometry/unit = %s): organs are 1 mm to 1 m; is the "
+                "unit right?",
+                size, cases::to_string(p.geometry.unit).c_str());
+  notes.push_back(text);
+  std::cerr << "msfem: warning: " << p.file.string() << ": " << text << "\n";
+}
+
+cases::Surface load_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
+  const auto& g = p.geometry;
+  cases::Surface s = cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
+                                                           : cases::read_surface(g.source, g.unit);
+  if (g.simplify_to_vertices > s.num_vertices())
+    throw cases::InputError(p.file.string() + ": geometry/simplify to vertices = " +
+                            std::to_string(g.simplify_to_vertices) + " is more than the " +
+                            std::to_string(s.num_vertices()) + " vertices of " + g.source +
+                            " (simplification only removes vertices; 0 keeps the surface)");
+  if (g.simplify_to_vertices > 0 && g.simplify_to_vertices < s.num_vertices()) {
+    const auto before = s.num_vertices();
+    try {
+      s = cases::simplify(s, g.simplify_to_vertices);
+    } catch (const std::exception& e) {
+      throw cases::InputError(p.file.string() + ": geometry/simplify to vertices: " + e.what());
+    }
+    notes.push_back("simplified from " + std::to_string(before) + " to " +
+                    std::to_string(s.num_vertices()) + " vertices");
+  }
+  if (g.smoothing_iterations > 0) cases::smooth_taubin(s, g.smoothing_iterations);
+  const cases::SurfaceReport report = cases::orient_and_validate(s);
+  for (const auto& f : report.fixes)
+    notes.push_back(f);
+  if (!report.ok())
+    throw cases::InputError(p.file.string() + ": surface " + g.source + " is not a valid closed " +
+                            "surface: " + report.defects.front().message);
+  warn_if_not_organ_sized(p, s, notes);
+  return s;
+}
+
+std::function<bool(const Eigen::Vector3d&)> fixed_region(const cases::CaseParameters& p,
+                                                         const cases::Surface& s,
+                                                         const Eigen::Vector3d& centroid) {
+  using Kind = cases::SupportParameters::Kind;
+  const auto& sp = p.support;
+  switch (sp.kind) {
+    case Kind::inner_core: {
+      const auto inside = fem_reference::inner_core(s.vertices, s.triangles, sp.inner_core_scale);
+      // Nodes exactly on the core's boundary (the layered model's inner tier, skeleton points drawn
+      // to the same scale) count as inside: test a point a hair closer to the centroid.
+      return [inside, centroid](const Eigen::Vector3d& x) {
+        return inside(centroid + (1.0 - 1e-9) * (x - centroid));
+      };
+    }
+    case Kind::half_space:
+      return fem_reference::half_space(sp.half_space_point, sp.half_space_normal);
+    case Kind::sphere:
+      return fem_reference::ball(sp.sphere_center, sp.sphere_radius_m);
+  }
+  throw cases::InputError(p.file.string() + ": unknown support kind");
+}
+
+ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s,
+                         const Eigen::MatrixX3d& normals, const Eigen::Vector3d& centroid,
+                         const Eigen::Vector3d& direction) {
+  const int best = farthest_vertex(s, centroid, direction);
+  ToolPlacement t;
+  t.vertex = best;
+  t.contact_point = s.vertices.row(best).transpose();
+  t.outward_normal = normals.row(best).transpose();
+  t.radius = p.loads.tool.radius_m;
+  t.depth = p.loads.tool.depth_m;
+  const Eigen::Vector3d extent = (cases::bounding_box(s).row(1) - cases::bounding_box(s).row(0));
+  if (t.depth >= 0.5 * extent.minCoeff())
+    throw cases::InputError(p.file.string() + ": loads/tool/depth " + std::to_string(t.depth) +
+                            " m is not small against the model (smallest extent " +
+                            std::to_string(extent.minCoeff()) + " m)");
+  return t;
+}
+
+/// Distance from x to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+double distance_to_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = x - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return (x - a).norm();
+  const Eigen::Vector3d bp = x - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return (x - b).norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (x - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = x - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return (x - c).norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (x - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (x - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denominator = 1.0 / (va + vb + vc);
+  return (x - (a + ab * vb * denominator + ac * vc * denominator)).norm();
+}
+
+/// The closest approach of the surface to `center`.
+double distance_to_surface(const cases::Surface& s, const Eigen::Vector3d& center) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index t = 0; t < s.num_triangles(); ++t)
+    nearest = std::min(nearest, distance_to_triangle(center, s.vertices.row(s.triangles(t, 0)),
+                                                     s.vertices.row(s.triangles(t, 1)),
+                                                     s.vertices.row(s.triangles(t, 2))));
+  return nearest;
+}
+
+// A contact tool must start outside the body (touching it) and reach it at full depth: a sphere
+// already inside would be pushed out, not in, and one that misses compares nothing.
+void check_contact_start(const cases::CaseParameters& p, const cases::Surface& s,
+                         const ToolPlacement& t, const Eigen::Vector3d& d) {
+  const std::string where = p.file.string() + ": loads/tool: the contact tool at direction (" +
+                            std::to_string(d.x()) + ", " + std::to_string(d.y()) + ", " +
+                            std::to_string(d.z()) + ")";
+  const double start = distance_to_surface(s, t.contact_point + t.radius * t.outward_normal);
+  if (start < (1 - 1e-3) * t.radius)
+    throw cases::InputError(where +
+                            " starts inside the body: before it is pushed the surface comes " +
+                            std::to_string(t.radius - start) + " m inside its sphere (radius " +
+                            std::to_string(t.radius) +
+                            " m; the surface is concave there: choose another direction "
+                            "or a smaller radius)");
+  if (distance_to_surface(s, t.pushed_center()) >= t.radius)
+    throw cases::InputError(where + " misses the body at depth " + std::to_string(t.depth) + " m");
+}
+
+// A patch force that pulls only fixed nodes moves nothing in either model: the comparison would
+// divide by a reference that does not move.
+void check_patch_force(const Problem& problem) {
+  const auto& p = problem.parameters;
+  const std::vector<int> patch = patch_vertices(problem);
+  const auto free = std::count_if(patch.begin(), patch.end(), [&](int v) {
+    return !problem.fixed_region(problem.surface.vertices.row(v).transpose());
+  });
+  if (free == 0) {
+    const Eigen::Vector3d& d = p.loads.patch_force.direction;
+    throw cases::InputError(
+        p.file.string() + ": loads/patch force/direction (" + std::to_string(d.x()) + ", " +
+        std::to_string(d.y()) + ", " + std::to_string(d.z()) + "): all " +
+        std::to_string(patch.size()) +
+        " surface vertices of the patch lie in the fixed region (support/fixed region): the "
+        "force would move nothing; point the patch at a free part of the surface");
+  }
+}
+
+// A local point distribution at the tool: the surface both models are built on gets edges no longer
+// than `edge` within `radius` of every tool, so a tool between the coarse nodes meets several.
+void refine_at_tools(Problem& problem) {
+  const auto& p = problem.parameters;
+  const auto& r = p.mass_spring.contact_refinement;
+  if (!r.enabled) return;
+  if (problem.tools.empty())
+    throw cases::InputError(p.file.string() +
+                            ": mass spring/contact refinement/enabled = true refines around the "
+                            "tool, but loads/tool is off");
+  double tool_radius = 0;
+  for (const ToolPlacement& t : problem.tools)
+    tool_radius = std::max(tool_radius, t.radius);
+  LocalRefinement local;
+  local.radius_m = r.radius_m > 0 ? r.radius_m : 2 * tool_radius;
+  local.edge_m = r.edge_m > 0 ? r.edge_m : tool_radius / 3;
+  // Each ball's cap needs about its area over a triangle's (√3/4 h²) triangles, half as many
+  // vertices: refuse before bisecting what no model could solve.
+  const double per_tool = M_PI * local.radius_m * local.radius_m /
+                          (std::sqrt(3.0) / 4 * local.edge_m * local.edge_m) / 2;
+  if (per_tool * double(problem.tools.size()) > 2e6)
+    throw cases::InputError(p.file.string() + ": mass spring/contact refinement: edge length " +
+                            std::to_string(local.edge_m) + " m within " +
+                            std::to_string(local.radius_m) + " m of " +
+                            std::to_string(problem.tools.size()) + " tool(s) would add about " +
+                            std::to_string(std::lround(per_tool * problem.tools.size())) +
+                            " surface vertices (at most 2,000,000): choose a longer edge");
+  std::vector<cases::RefinementBall> balls;
+  for (const ToolPlacement& t : problem.tools)
+    balls.push_back({t.contact_point, local.radius_m});
+  cases::SurfaceRefinement refined = cases::refine_near(problem.surface, balls, local.edge_m);
+  local.added_vertices = refined.added_vertices;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "surface refined to edges <= %.3g m within %.3g m of each tool (mass spring/"
+                "contact refinement): %d vertices added",
+                local.edge_m, local.radius_m, local.added_vertices);
+  problem.notes.push_back(text);
+  problem.surface = std::move(refined.surface);
+  problem.local_refinement = local;
+}
+
+}  // namespace
+
+fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
+  const Eigen::Vector3d center = tool.pushed_center();
+  const Eigen::Vector3d inward = -tool.outward_normal.normalized();
+  const double r = tool.radius;
+  fem_reference::Support support;
+  support.name = "tool";
+  support.boundary_nodes_only = true;
+  support.region = [center, r](const Eigen::Vector3d& x) { return (x - center).norm() < r; };
+  // Largest t with |x + t n − c| = r: t = −w·n + sqrt((w·n)² − |w|² + r²), w = x − c.
+  support.displacement = [center, inward, r](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    const Eigen::Vector3d w = x - center;
+    const double wn = w.dot(inward);
+    const double t = -wn + std::sqrt(std::max(0.0, wn * wn - w.squaredNorm() + r * r));
+    return t * inward;
+  };
+  return support;
+}
+
+int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
+                    const Eigen::Vector3d& direction) {
+  Eigen::Index best = 0;
+  ((surface.vertices.rowwise() - centroid.transpose()) * direction).maxCoeff(&best);
+  return static_cast<int>(best);
+}
+
+std::vector<int> patch_vertices(const Problem& problem) {
+  const auto& patch = problem.parameters.loads.patch_force;
+  std::vector<int> vertices;
+  if (!patch.enabled) return vertices;
+  const auto& s = problem.surface;
+  const int center = farthest_vertex(s, problem.centroid, patch.direction);
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    if ((s.vertices.row(v) - s.vertices.row(center)).norm() <= patch.radius_m)
+      vertices.push_back(int(v));
+  return vertices;
+}
+
+Eigen::Vector3d mean_displacement(const Eigen::MatrixX3d& displacement,
+                                  const std::vector<int>& vertices) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int v : vertices)
+    sum += displacement.row(v).transpose();
+  return vertices.empty() ? sum : Eigen::Vector3d(sum / double(vertices.size()));
+}
+
+double volume_change(const cases::Surface& surface, const Eigen::MatrixX3d& displacement) {
+  cases::Surface deformed = surface;
+  deformed.vertices += displacement;
+  return cases::signed_volume(deformed) / cases::signed_volume(surface) - 1.0;
+}
+
+ToolPlacement at_depth(ToolPlacement tool, double depth) {
+  tool.depth = depth;
+  return tool;
+}
+
+Problem make_problem(const cases::CaseParameters& parameters) {
+  Problem problem;
+  problem.parameters = parameters;
+  problem.surface = load_surface(parameters, problem.notes);
+  const cases::Surface& s = problem.surface;
+  problem.centroid = cases::vertex_centroid(s);
+  problem.fixed_region = fixed_region(parameters, s, problem.centroid);
+
+  int fixed_surface_nodes = 0;
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    fixed_surface_nodes += problem.fixed_region(s.vertices.row(v).transpose());
+  if (fixed_surface_nodes == s.num_vertices())
+    throw cases::InputError(parameters.file.string() +
+                            ": support: the fixed region contains the whole surface");
+
+  if (parameters.loads.tool.enabled) {
+    const Eigen::MatrixX3d normals = cases::vertex_normals(s);
+    for (const auto& d : parameters.loads.tool.directions) {
+      ToolPlacement t = place_tool(parameters, s, normals, problem.centroid, d);
+      if (problem.fixed_region(t.contact_point))
+        throw cases::InputError(parameters.file.string() + ": loads/tool: the tool at direction (" +
+                                std::to_string(d.x()) + ", " + std::to_string(d.y()) + ", " +
+                                std::to_string(d.z()) + ") presses on a fixed node");
+      t.frictionless = parameters.loads.tool.mode == cases::ToolParameters::Mode::contact;
+      if (t.frictionless) check_contact_start(parameters, s, t, d);
+      problem.tools.push_back(t);
+    }
+  }
+  refine_at_tools(problem);
+  if (parameters.loads.patch_force.enabled) check_patch_force(problem);
+  if (problem.tools.empty() && !parameters.loads.patch_force.enabled &&
+      !(parameters.loads.gravity_m_per_s2.norm() > 0))
+    throw cases::InputError(parameters.file.string() +
+                            ": loads: no tool, patch force or gravity: nothing deforms the model");
+  return problem;
+}
+
+}  // namespace msfem::compare

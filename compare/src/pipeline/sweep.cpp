@@ -1,0 +1,187 @@
+#include "msfem/compare/pipeline/sweep.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <sstream>
+
+#include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/surface_generators.hpp"
+#include "msfem/cases/surface_io.hpp"
+#include "msfem/compare/pipeline/case_run.hpp"
+#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/writers/run_summary.hpp"
+
+namespace msfem::compare {
+namespace {
+
+std::vector<int> default_resolutions(const cases::CaseParameters& p) {
+  if (cases::is_surface_generator(p.geometry.source)) return {2, 3, 4, 5};
+  const int available =
+      static_cast<int>(cases::read_surface(p.geometry.source, p.geometry.unit).num_vertices());
+  std::vector<int> r;
+  for (int n : {2000, 5000, 9177, 20000, 40000})
+    if (n < 0.95 * available) r.push_back(n);  // not a near-copy of the surface as read
+  r.push_back(available);
+  return r;
+}
+
+// The case at one resolution: the icosphere level replaced, or the simplification target set.
+cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
+  if (cases::is_surface_generator(p.geometry.source)) {
+    const auto first = p.geometry.source.find(':');
+    const auto second = p.geometry.source.find(':', first + 1);
+    p.geometry.source = p.geometry.source.substr(0, first + 1) + std::to_string(resolution) +
+                        (second == std::string::npos ? "" : p.geometry.source.substr(second));
+  } else {
+    p.geometry.simplify_to_vertices = resolution;
+  }
+  return p;
+}
+
+// One resolution's points: every variant with every integrator.
+std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
+                                         const SweepSettings& settings,
+                                         const std::filesystem::path& fem_cache_directory) {
+  std::vector<SweepPoint> points;
+  const cases::CaseParameters p = at_resolution(parameters, resolution);
+  RunSettings run_settings;
+  run_settings.quiet = true;
+  run_settings.force_depth_curve = false;
+  run_settings.time_dynamics = false;
+  run_settings.all_tools = false;  // accuracy against speed at the case's first tool
+  run_settings.fem_cache_directory = fem_cache_directory;
+  const CaseRun run = run_case(p, run_settings);
+  const std::optional<ToolPlacement> tool =
+      run.problem.tools.empty() ? std::nullopt
+                                : std::optional<ToolPlacement>(run.problem.tools.front());
+  for (const auto& v : run.variants) {
+    const BuiltVariant built = build_variant(v.kind, run.problem, run.mesh, tool);
+    const Eigen::VectorXd& equilibrium = v.equilibrium;  // run_case's, from rest as here
+    for (const auto& integrator : settings.integrators) {
+      cases::TimingParameters timing = p.timing;
+      timing.integrator = integrator;
+      timing.dt_s = 0.0;  // each integrator at half its own stable step
+      const Timing t = time_variant(built, timing, equilibrium, /*measure_settling=*/false);
+      SweepPoint pt;
+      pt.variant = v.name;
+      pt.integrator = massspring::to_string(integrator);
+      pt.resolution = resolution;
+      pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
+      pt.nodes = v.nodes;
+      pt.springs = v.springs;
+      pt.rel_l2_error = v.errors.all.rel_l2_error;
+      pt.reaction_force_rel_error = v.reaction_force_rel_error;
+      pt.stable_dt_s = t.stable_dt_s;
+      pt.steps_per_second = t.steps_per_second;
+      pt.realtime_factor = t.realtime_factor;
+      pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
+      if (!run.fem_error.loads.empty()) {
+        pt.fem_estimated_rel_l2_error = run.fem_error.loads.front().rel_l2_error;
+        pt.fem_estimated_force_rel_error = run.fem_error.loads.front().force_rel_error;
+      }
+      pt.not_resolved_by_reference = unresolved_metrics(run, v);
+      points.push_back(pt);
+    }
+  }
+  return points;
+}
+
+}  // namespace
+
+SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
+                      const std::filesystem::path& fem_cache_directory) {
+  const std::vector<int> resolutions =
+      settings.resolutions.empty() ? default_resolutions(parameters) : settings.resolutions;
+  const Progress progress(settings.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  SweepResult result;
+  std::vector<SweepPoint>& points = result.points;
+  std::exception_ptr first_failure;
+  for (std::size_t r = 0; r < resolutions.size(); ++r) {
+    try {
+      // All of a resolution's points or none of them.
+      const std::vector<SweepPoint> more =
+          sweep_resolution(parameters, resolutions[r], settings, fem_cache_directory);
+      points.insert(points.end(), more.begin(), more.end());
+    } catch (const std::exception& e) {
+      if (!first_failure) first_failure = std::current_exception();
+      result.failed_resolutions.emplace_back(resolutions[r], e.what());
+      progress.stage("sweep resolution " + std::to_string(resolutions[r]) + " failed: " + e.what());
+    }
+    progress.advance(
+        "sweep resolution " + std::to_string(resolutions[r]), static_cast<int>(r + 1),
+        static_cast<int>(resolutions.size()),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  // Nothing to show: the first failure as it was (bad input stays bad input).
+  if (points.empty() && first_failure) std::rethrow_exception(first_failure);
+  return result;
+}
+
+nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& p : result.points)
+    list.push_back(
+        {{"variant", p.variant},
+         {"integrator", p.integrator},
+         {"resolution", p.resolution},
+         {"surface_vertices", p.surface_vertices},
+         {"nodes", p.nodes},
+         {"springs", p.springs},
+         {"rel_l2_error", p.rel_l2_error},
+         {"reaction_force_rel_error", p.reaction_force_rel_error},
+         {"stable_dt_s", p.stable_dt_s},
+         {"steps_per_second", p.steps_per_second},
+         {"realtime_factor", p.realtime_factor},
+         {"ms_per_60hz_frame", p.ms_per_60hz_frame},
+         {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
+         {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
+         {"not_resolved_by_reference", p.not_resolved_by_reference}});
+  nlohmann::json failed = nlohmann::json::array();
+  for (const auto& [resolution, why] : result.failed_resolutions)
+    failed.push_back({{"resolution", resolution}, {"error", why}});
+  return {{"case", parameters.name},
+          {"git_revision", git_revision()},
+          {"machine", machine_description()},
+          {"units", {{"length", "m"}, {"time", "s"}}},
+          {"points", list},
+          {"failed_resolutions", failed}};
+}
+
+std::string sweep_table(const std::vector<SweepPoint>& points) {
+  std::ostringstream out;
+  out << "| variant | integrator | resolution | surface vertices | nodes | springs | rel L2 | "
+         "force err | FEM own err (L2 / force) | stable dt s | steps/s | realtime factor | "
+         "ms/60 Hz frame |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  char row[512];
+  auto number = [](const std::optional<double>& x) {
+    char cell[32] = "-";
+    if (x) std::snprintf(cell, sizeof cell, "%.4f", *x);
+    return std::string(cell);
+  };
+  auto flag = [](const SweepPoint& p, const char* metric) {
+    const auto& list = p.not_resolved_by_reference;
+    return std::find(list.begin(), list.end(), metric) != list.end() ? " ‡" : "";
+  };
+  bool any_flag = false;
+  for (const auto& p : points) {
+    std::snprintf(
+        row, sizeof row,
+        "| %s | %s | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | %.3g | %.3f |\n",
+        p.variant.c_str(), p.integrator.c_str(), p.resolution, p.surface_vertices, p.nodes,
+        p.springs, p.rel_l2_error, flag(p, "rel_l2_error"), p.reaction_force_rel_error,
+        flag(p, "reaction_force_rel_error"), number(p.fem_estimated_rel_l2_error).c_str(),
+        number(p.fem_estimated_force_rel_error).c_str(), p.stable_dt_s, p.steps_per_second,
+        p.realtime_factor, p.ms_per_60hz_frame);
+    out << row;
+    any_flag = any_flag || !p.not_resolved_by_reference.empty();
+  }
+  if (any_flag)
+    out << "\n‡ within 3x of the reference's own error: not resolved by this reference\n";
+  return out.str();
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,405 @@
+#include "msfem/compare/pipeline/variant_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include "msfem/cases/errors.hpp"
+#include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/surface_simplification.hpp"
+#include "msfem/fem_reference/supports_and_loads.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/modal_damping.hpp"
+#include "msfem/massspring/stability.hpp"
+#include "msfem/massspring/static_solver.hpp"
+#include "msfem/massspring/surface_contact.hpp"
+#include "msfem/massspring/surface_geometry.hpp"
+#include "msfem/massspring/tool_contact.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+#include "pipeline/cholmod_factor.hpp"
+
+namespace msfem::compare {
+namespace {
+
+namespace ms = msfem::massspring;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+ms::SpringNetwork three_tier_network(const Problem& problem, const ms::Material& material) {
+  const auto& p = problem.parameters;
+  ms::ThreeTierOptions o;
+  o.inner_tiers = p.mass_spring.inner_tiers;
+  o.tier2_scale = p.mass_spring.middle_tier_scale;
+  o.tier3_scale = p.mass_spring.inner_tier_scale;
+  o.center = problem.centroid;  // the support's, which a refined surface's would miss
+  o.tier23_diagonals = p.mass_spring.inner_diagonals;
+  o.material = material;
+  return ms::build_three_tier(problem.surface.vertices, problem.surface.triangles, o);
+}
+
+ms::SpringNetwork single_layer_network(const Problem& problem, const ms::Material& material) {
+  ms::SingleLayerOptions o;
+  // Every node not supported is tied to its rest position (as simulators' rest-shape springs
+  // do; the supported ones are fixed, so their anchors do nothing). A bare membrane held only at
+  // some nodes, like the brain's base, has no transverse stiffness at rest: Newton failed on it.
+  o.anchor_to_rest = true;
+  o.material = material;
+  return ms::build_single_layer(problem.surface.vertices, problem.surface.triangles, o);
+}
+
+ms::SpringNetwork tet_edges_network(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                                    const ms::Material& material) {
+  ms::TetEdgesOptions o;
+  o.stiffness_rule = problem.parameters.mass_spring.stiffness_model;
+  o.material = material;
+  const Eigen::MatrixX4i tets = mesh.tetrahedra;
+  return ms::build_tet_edges(mesh.vertices, tets, o);
+}
+
+ms::SpringNetwork skeleton_network(const Problem& problem, const ms::Material& material) {
+  const auto& ms_p = problem.parameters.mass_spring;
+  const auto& s = problem.surface;
+  const int wanted = ms_p.skeleton_control_points > 0
+                         ? ms_p.skeleton_control_points
+                         : std::max(20, static_cast<int>(s.num_vertices() / 10));
+  const cases::Surface control = cases::simplify(s, std::min<int>(wanted, s.num_vertices()));
+  ms::SkeletonOptions o;
+  o.control_scale = ms_p.skeleton_draw_factor;
+  o.center = problem.centroid;
+  o.material = material;
+  return ms::build_skeleton(s.vertices, s.triangles, control.vertices, control.triangles, o);
+}
+
+ms::SpringNetwork build_network(cases::Variant variant, const Problem& problem,
+                                const fem_reference::VolumeMesh& mesh) {
+  ms::Material material;
+  material.youngs_modulus = problem.parameters.material.youngs_modulus_pa;
+  material.density = problem.parameters.material.density_kg_per_m3;
+  switch (variant) {
+    case cases::Variant::three_tier:
+      return three_tier_network(problem, material);
+    case cases::Variant::single_layer:
+      return single_layer_network(problem, material);
+    case cases::Variant::tet_edges:
+      return tet_edges_network(problem, mesh, material);
+    case cases::Variant::skeleton:
+      return skeleton_network(problem, material);
+  }
+  throw std::logic_error("build_network: a variant without a builder");
+}
+
+std::string scientific(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
+  const auto& patch = problem.parameters.loads.patch_force;
+  if (!patch.enabled) return;
+  const auto& s = problem.surface;
+  const Eigen::VectorXd areas = ms::vertex_areas(s.vertices, s.triangles);
+  const std::vector<int> nodes = patch_vertices(problem);
+  double total_area = 0;
+  for (int v : nodes)
+    total_area += areas[v];
+  const auto& surface_nodes = model.network().surface_nodes;
+  for (int v : nodes)
+    model.set_external_force(surface_nodes[v], patch.force_n * areas[v] / total_area);
+}
+
+// The variants whose builders give the volume elements volume preservation acts on.
+bool has_volume_elements(cases::Variant variant) {
+  return variant == cases::Variant::three_tier || variant == cases::Variant::tet_edges;
+}
+
+// The volume elements of a variant that has them (three_tier's shell prisms, tet_edges'
+// tetrahedra), κ = λ(E, ν) − λ(E, 1/4) times the case's `volume` group scale.
+
+void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
+  const auto& p = problem.parameters;
+  ms::MassSpringModel& model = *variant.model;
+  double modulus = ms::volume_modulus_for(p.material.youngs_modulus_pa, p.material.poisson_ratio);
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (group == volume_group) modulus *= factor;
+  const auto& rest = model.network().rest_positions;
+  if (!has_volume_elements(variant.kind)) return;
+  ms::VolumeElements elements;
+  if (variant.kind == cases::Variant::three_tier)
+    elements = ms::tier_prisms(rest, problem.surface.triangles,
+                               static_cast<int>(problem.surface.num_vertices()), 3, modulus);
+  else
+    elements = ms::tetrahedron_elements(rest, variant.tetrahedra, modulus);
+  const int all = elements.num_elements();
+  // The brain's offset inner tiers fold where the surface is concave: such prisms are inverted or
+  // flat at rest, and with them Newton stalled (residual ~1e-7 N after 100 iterations).
+  if (const int removed = ms::remove_degenerate_elements(elements, rest, 1e-3); removed > 0)
+    variant.warnings.push_back(
+        "volume preservation: " + std::to_string(removed) + " of " + std::to_string(all) +
+        " volume elements are inverted or flat at rest (folded tiers, slivers) and are left out");
+  if (elements.num_elements() > 0)
+    model.set_volume(ms::VolumeForceField(model.num_nodes(), std::move(elements)));
+}
+
+}  // namespace
+
+const std::vector<std::string>& spring_groups_of(cases::Variant variant) {
+  static const std::map<cases::Variant, std::vector<std::string>> groups = {
+      {cases::Variant::three_tier,
+       {"tier1_edges", "tier2_edges", "tier12_diagonals", "tier12_radial", "tier23_radial"}},
+      {cases::Variant::single_layer, {"surface_edges"}},
+      {cases::Variant::tet_edges, {"tet_edges"}},
+      {cases::Variant::skeleton, {"surface_edges", "skeleton_edges", "links"}}};
+  return groups.at(variant);
+}
+
+std::vector<std::string> spring_groups_of(cases::Variant variant, const cases::CaseParameters& p) {
+  std::vector<std::string> groups = spring_groups_of(variant);
+  if (variant == cases::Variant::three_tier && p.mass_spring.inner_diagonals)
+    groups.emplace_back("tier23_diagonals");
+  if (p.mass_spring.volume_preservation && has_volume_elements(variant))
+    groups.emplace_back(volume_group);
+  return groups;
+}
+
+void check_group_names(const cases::CaseParameters& p) {
+  std::set<std::string> groups;
+  for (const auto& v : p.mass_spring.variants) {
+    const std::vector<std::string> of_variant = spring_groups_of(v, p);
+    groups.insert(of_variant.begin(), of_variant.end());
+  }
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (!groups.count(group)) {
+      std::string list;
+      for (const auto& g : groups)
+        list += (list.empty() ? "" : ", ") + g;
+      throw cases::InputError(
+          p.file.string() + ": mass spring/group scales: no variant of the case has a group '" +
+          group + "'" + (group == volume_group ? " (" + std::string(volume_hint) + ")" : "") +
+          "; the case's groups: " + list);
+    }
+}
+
+void check_variants_fit(const Problem& problem) {
+  const auto& p = problem.parameters;
+  const auto& variants = p.mass_spring.variants;
+  const int n = static_cast<int>(problem.surface.num_vertices());
+  if (std::find(variants.begin(), variants.end(), cases::Variant::skeleton) != variants.end() &&
+      p.mass_spring.skeleton_control_points > n)
+    throw cases::InputError(p.file.string() + ": mass spring/skeleton/control points = " +
+                            std::to_string(p.mass_spring.skeleton_control_points) +
+                            " is more than the surface's " + std::to_string(n) +
+                            " vertices (the control mesh is a simplified copy of the surface)");
+}
+
+void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool) {
+  ms::MassSpringModel& model = *variant.model;
+  for (int node : variant.tool_patch)
+    model.release_node(node);
+  variant.tool_patch.clear();
+  if (tool.frictionless) {
+    // The sphere against the surface's triangles, at the penalty activate_surface_contact picks
+    // from the network's stiffness (the same at every depth of the loading path).
+    ms::ToolIndentation indent;
+    indent.contact_point = tool.contact_point;
+    indent.inward_direction = -tool.outward_normal;
+    indent.radius = tool.radius;
+    indent.depth = tool.depth;
+    variant.contact_pressure_penalty =
+        ms::activate_surface_contact(model, indent, variant.contact_pressure_penalty);
+    return;
+  }
+  const fem_reference::Support support = tool_patch_support(tool);
+  // The very same patch and displacement as the FEM's tool support, node for node: the case's
+  // surface vertices, and tet_edges' extra surface nodes where it shares the FEM's refined mesh.
+  const auto& network = model.network();
+  for (const int node : network.surface_nodes) {
+    const Eigen::Vector3d x = network.rest_positions.row(node).transpose();
+    if (!support.region(x)) continue;
+    model.prescribe_displacement(node, support.displacement(x));
+    variant.tool_patch.push_back(node);
+  }
+  // Supports win over the tool where both catch a node (as in the FEM, where the fixed region is
+  // listed after the tool but a tool on a fixed node is refused by make_problem).
+}
+
+std::optional<int> inverted_tetrahedra(const BuiltVariant& variant, const Eigen::VectorXd& x) {
+  if (variant.tetrahedra.rows() == 0) return std::nullopt;
+  const auto& rest = variant.model->network().rest_positions;
+  auto signed_volume = [&](auto&& position, Eigen::Index t) {
+    const Eigen::Vector3d a = position(variant.tetrahedra(t, 0));
+    return (position(variant.tetrahedra(t, 1)) - a)
+        .cross(position(variant.tetrahedra(t, 2)) - a)
+        .dot(position(variant.tetrahedra(t, 3)) - a);
+  };
+  const auto at_rest = [&](int n) -> Eigen::Vector3d { return rest.row(n).transpose(); };
+  const auto moved = [&](int n) -> Eigen::Vector3d { return x.segment<3>(3 * n); };
+  int inverted = 0;
+  for (Eigen::Index t = 0; t < variant.tetrahedra.rows(); ++t)
+    if (signed_volume(moved, t) * signed_volume(at_rest, t) <= 0.0) ++inverted;
+  return inverted;
+}
+
+BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
+                           const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool) {
+  const auto& p = problem.parameters;
+  BuiltVariant variant;
+  variant.kind = kind;
+  variant.name = cases::name_of(kind);
+  variant.case_surface_vertices = problem.surface.num_vertices();
+  try {
+    ms::SpringNetwork network = build_network(kind, problem, mesh);
+    if (kind == cases::Variant::tet_edges) variant.tetrahedra = mesh.tetrahedra;
+    if (problem.local_refinement) {
+      // three_tier copies the surface into its two inner tiers.
+      const int added = problem.local_refinement->added_vertices;
+      variant.refinement_added_nodes = kind == cases::Variant::three_tier ? 3 * added : added;
+    }
+    variant.warnings = network.warnings;
+    variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
+    ms::MassSpringModel& model = *variant.model;
+    const auto& rest = model.network().rest_positions;
+    for (int node = 0; node < model.num_nodes(); ++node)
+      if (problem.fixed_region(rest.row(node).transpose())) model.fix_node(node);
+    for (const auto& [group, factor] : p.mass_spring.group_scales) {
+      if (std::find(model.network().spring_group_names.begin(),
+                    model.network().spring_group_names.end(),
+                    group) == model.network().spring_group_names.end())
+        continue;  // a group of another variant
+      model.scale_group_stiffness(group, factor);
+    }
+    if (p.mass_spring.volume_preservation) set_volume_preservation(variant, problem);
+    if (model.constrained_nodes().empty() && model.network().num_anchors() == 0)
+      throw cases::InputError(p.file.string() + ": variant " + variant.name +
+                              ": no node lies in the fixed region and nothing anchors it, so it "
+                              "would float away (adjust the support or the variant's geometry)");
+    model.set_damping(ms::damping_for_ratio(model.network(), p.mass_spring.damping_ratio));
+    model.set_gravity(p.loads.gravity_m_per_s2);
+    apply_patch_force(model, problem);
+    if (tool) set_tool_depth(variant, *tool);
+  } catch (const ms::ModelError& e) {
+    throw cases::InputError(p.file.string() + ": variant " + variant.name + ": " + e.what());
+  }
+  return variant;
+}
+
+StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::VectorXd& start) {
+  const ms::MassSpringModel& model = *variant.model;
+  const auto clock_start = Clock::now();
+  ms::StaticOptions options;
+  // A sparse factorisation's fill-in grows quickly with the brain-scale networks; CG does not.
+  if (model.num_nodes() > 500000) options.linear_solver = ms::StaticLinearSolver::cg;
+  // Supernodal: on the brain's tet_edges network SimplicialLDLT took ~90 % of the statics.
+  options.factorization = cholmod_factorization();
+  ms::StaticResult r;
+  try {
+    r = ms::solve_static(model, options, start);
+  } catch (const ms::ModelError& e) {
+    // A singular tangent at some Newton iterate is this load's solver failing (the supports were
+    // checked when the variant was built): the variant fails, the run goes on.
+    throw std::runtime_error("variant " + variant.name + ": " + e.what());
+  }
+  StaticSolution solution;
+  solution.solve_time_s = seconds_since(clock_start);
+  if (!r.converged)
+    throw std::runtime_error("variant " + variant.name + ": Newton did not converge in " +
+                             std::to_string(r.iterations) + " iterations (residual " +
+                             scientific(r.residual_norm) + " N)");
+  solution.x = r.x;
+  solution.newton_iterations = r.iterations;
+  solution.surface_displacement =
+      model.surface_displacement(r.x).topRows(variant.case_surface_vertices);
+  if (!variant.tool_patch.empty())
+    solution.tool_force = ms::patch_reaction_force(model, r.x, variant.tool_patch);
+  else if (model.contact())
+    solution.tool_force = ms::contact_reaction_force(model, r.x);
+  return solution;
+}
+
+Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
+                    const Eigen::VectorXd& equilibrium, bool measure_settling) {
+  const ms::MassSpringModel& model = *variant.model;
+  const ms::IntegratorKind kind = timing.integrator;
+  Timing t;
+  t.integrator = ms::to_string(kind);
+  const ms::State start = ms::initial_state(model);
+  t.predicted_stable_dt_s = ms::predicted_stable_dt(model, kind, start.x);
+  if (kind == ms::IntegratorKind::implicit_euler || !std::isfinite(t.predicted_stable_dt_s)) {
+    // Unconditionally stable: report the step a haptic loop would use (1 kHz).
+    t.stable_dt_s = 1e-3;
+  } else {
+    const double guess = t.predicted_stable_dt_s;
+    t.stable_dt_s = ms::measure_stable_dt(model, kind, 0.25 * guess, 4.0 * guess, 400, 0.02);
+  }
+  t.dt_s = timing.dt_s > 0 ? timing.dt_s : 0.5 * t.stable_dt_s;
+
+  // The real-time path: the fast stepper for symplectic Euler (the prescribed patch is a support
+  // it honours); the generic integrator otherwise, and for volume preservation and the contact
+  // tool, which the fast kernels do not have.
+  const bool fast = kind == ms::IntegratorKind::symplectic_euler && model.fields().empty();
+  std::unique_ptr<ms::FastExplicitStepper> stepper;
+  ms::Integrator integrator(kind);
+  ms::State state = start;
+  if (fast) {
+    stepper = std::make_unique<ms::FastExplicitStepper>(model);
+    stepper->set_state(start);
+  }
+  auto advance = [&](int count) {
+    if (fast) {
+      stepper->step(t.dt_s, count);
+    } else {
+      for (int i = 0; i < count; ++i)
+        integrator.step(model, state, t.dt_s);
+    }
+  };
+  auto current = [&]() { return fast ? stepper->state() : state; };
+
+  // Settling, from rest with the load applied: checked every `stride` steps.
+  const Eigen::VectorXd x_rest = start.x;
+  const double travel = (equilibrium - x_rest).norm();
+  const int stride = 20;
+  const double wall_limit_s = 20.0;
+  const auto settle_start = Clock::now();
+  while (measure_settling && seconds_since(settle_start) < wall_limit_s) {
+    advance(stride);
+    const ms::State s = current();
+    if (!s.x.allFinite())
+      throw ms::DivergenceError("variant " + variant.name + " diverged while settling at dt " +
+                                    std::to_string(t.dt_s) + " s (stable dt " +
+                                    std::to_string(t.stable_dt_s) + " s)",
+                                t.dt_s, t.stable_dt_s);
+    if ((s.x - equilibrium).norm() <= 0.01 * travel) {
+      t.settled = true;
+      break;
+    }
+  }
+  t.settle_time_s = measure_settling ? seconds_since(settle_start) : 0.0;
+
+  // Speed: median of batches after a warm-up.
+  const int batches = 5;
+  const int per_batch = std::max(1, timing.steps / batches);
+  advance(std::max(1, per_batch / 4));
+  std::vector<double> rates;
+  for (int b = 0; b < batches; ++b) {
+    const auto batch_start = Clock::now();
+    advance(per_batch);
+    rates.push_back(per_batch / std::max(seconds_since(batch_start), 1e-9));
+  }
+  std::sort(rates.begin(), rates.end());
+  t.steps_per_second = rates[rates.size() / 2];
+  t.realtime_factor = t.stable_dt_s * t.steps_per_second;
+  t.ms_per_60hz_frame = 1000.0 * (1.0 / 60.0) / t.dt_s / t.steps_per_second;
+  return t;
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,342 @@
+// The report's plots, drawn by gnuplot: each function checks its input, writes a data file (one
+// block per series, gnuplot's `index`) and a script into a scratch folder, and runs gnuplot on the
+// script with the output aimed at write_file_atomically's temporary. Titles and names go through
+// single-quoted gnuplot strings and the noenhanced terminal option, so "three_tier" stays literal.
+
+#include "msfem/compare/writers/plots.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+#include <vector>
+
+#include "msfem/compare/writers/atomic_file.hpp"
+
+extern char** environ;  // NOLINT: POSIX's, passed on so gnuplot finds its fonts and locale
+
+namespace msfem::compare {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A folder under the system's temporary directory for one gnuplot run, removed with the object.
+class ScratchDirectory {
+ public:
+  ScratchDirectory() {
+    std::string pattern = (fs::temp_directory_path() / "msfem-plot-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+      throw std::system_error(errno, std::generic_category(), "cannot create " + pattern);
+    path_ = pattern;
+  }
+  ~ScratchDirectory() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  ScratchDirectory(const ScratchDirectory&) = delete;
+  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+struct GnuplotRun {
+  int exit_status = -1;  ///< gnuplot's exit status; 127 if it could not be started
+  std::string error_output;
+};
+
+// gnuplot ARGS without a shell (no quoting of paths), stdin from /dev/null so that a script never
+// waits for input, stdout discarded, stderr kept for the error message.
+GnuplotRun run_gnuplot(const std::vector<std::string>& arguments) {
+  ScratchDirectory scratch;
+  const std::string stderr_file = (scratch.path() / "stderr.txt").string();
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, stderr_file.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  std::vector<std::string> argv_text{"gnuplot"};
+  argv_text.insert(argv_text.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawn_error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  GnuplotRun run;
+  if (spawn_error != 0) {
+    run.exit_status = 127;
+    run.error_output = "cannot start gnuplot: " + std::string(std::strerror(spawn_error)) +
+                       " (install gnuplot-nox)";
+    return run;
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::system_error(errno, std::generic_category(), "waitpid");
+  }
+  run.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  run.error_output = read_text(stderr_file);
+  return run;
+}
+
+bool gnuplot_has_pngcairo() {
+  static const bool has = run_gnuplot({"-e", "set terminal pngcairo"}).exit_status == 0;
+  return has;
+}
+
+// A gnuplot single-quoted string: literal except that '' stands for '. Line breaks would end the
+// command, so they become spaces.
+std::string quoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) {
+    if (c == '\'')
+      out += "''";
+    else if (c == '\n' || c == '\r' || c == '\t')
+      out += ' ';
+    else
+      out += c;
+  }
+  return out + "'";
+}
+
+std::string number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+struct OutputFormat {
+  fs::path path;
+  std::string terminal;
+};
+
+std::string lowercase_extension(const fs::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+void require_picture_name(const fs::path& path) {
+  const std::string extension = lowercase_extension(path);
+  if (extension != ".png" && extension != ".svg")
+    throw std::invalid_argument("plot '" + path.string() + "': the name must end in .png or .svg");
+}
+
+OutputFormat choose_format(const fs::path& requested) {
+  const std::string svg =
+      "set terminal svg size 900,600 noenhanced font 'sans,12' background 'white'";
+  if (lowercase_extension(requested) == ".svg") return {requested, svg};
+  if (gnuplot_has_pngcairo())
+    return {requested, "set terminal pngcairo size 900,600 noenhanced font 'sans,11'"};
+  return {fs::path(requested).replace_extension(".svg"), svg};
+}
+
+// Runs `commands` (which read the data file through the gnuplot variable `data`) and writes the
+// picture atomically. Returns the path written.
+fs::path render(const fs::path& requested, const std::string& data, const std::string& commands) {
+  require_picture_name(requested);
+  if (!gnuplot_available())
+    throw std::runtime_error("cannot draw '" + requested.string() +
+                             "': gnuplot is not installed (Debian: gnuplot-nox)");
+  const OutputFormat format = choose_format(requested);
+  ScratchDirectory scratch;
+  const fs::path data_file = scratch.path() / "data.dat";
+  const fs::path script_file = scratch.path() / "plot.gp";
+  write_text_atomically(data_file, data);
+  write_file_atomically(format.path, [&](const fs::path& temporary) {
+    std::ostringstream script;
+    script << format.terminal << "\n"
+           << "set output " << quoted(temporary.string()) << "\n"
+           << "data = " << quoted(data_file.string()) << "\n"
+           << "set grid\nset key below\n"
+           << commands << "unset output\n";
+    write_text_atomically(script_file, script.str());
+    const GnuplotRun run = run_gnuplot({script_file.string()});
+    if (run.exit_status != 0)
+      throw std::runtime_error("gnuplot failed (exit " + std::to_string(run.exit_status) +
+                               "): " + run.error_output);
+    std::error_code error;
+    if (fs::file_size(temporary, error) == 0 || error)
+      throw std::runtime_error("gnuplot wrote nothing: " + run.error_output);
+  });
+  return format.path;
+}
+
+std::string labels(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
+  return "set title " + quoted(title) + "\nset xlabel " + quoted(xlabel) + "\nset ylabel " +
+         quoted(ylabel) + "\n";
+}
+
+void require_plottable(const std::string& series, const std::vector<double>& values,
+                       const char* axis, bool log_axis) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i]))
+      throw std::invalid_argument("series '" + series + "': " + axis + "[" + std::to_string(i) +
+                                  "] is not finite");
+    if (log_axis && !(values[i] > 0))
+      throw std::invalid_argument("series '" + series + "': " + axis + "[" + std::to_string(i) +
+                                  "] = " + number(values[i]) + " cannot go on a log axis");
+  }
+}
+
+}  // namespace
+
+bool gnuplot_available() {
+  static const bool available = run_gnuplot({"--version"}).exit_status == 0;
+  return available;
+}
+
+fs::path histogram(const fs::path& path, const std::string& title, const std::string& xlabel,
+                   const std::vector<std::pair<std::string, Eigen::VectorXd>>& series, int bins) {
+  if (series.empty()) throw std::invalid_argument("histogram '" + title + "': no series");
+  if (bins < 1) throw std::invalid_argument("histogram '" + title + "': bins must be >= 1");
+  double low = INFINITY, high = -INFINITY;
+  for (const auto& [name, values] : series) {
+    if (values.size() == 0) throw std::invalid_argument("series '" + name + "' is empty");
+    require_plottable(name, std::vector<double>(values.data(), values.data() + values.size()),
+                      "value", false);
+    low = std::min(low, values.minCoeff());
+    high = std::max(high, values.maxCoeff());
+  }
+  if (high == low) {  // one value everywhere (e.g. no error at all): a bin around it
+    const double half = low != 0 ? std::abs(low) * 0.5 : 1.0;
+    low -= half;
+    high += half;
+  }
+  const double width = (high - low) / bins;
+  // Common bins for every series; each drawn as a closed step outline from 0 up and back to 0.
+  std::ostringstream data;
+  for (const auto& [name, values] : series) {
+    std::vector<int> counts(static_cast<std::size_t>(bins), 0);
+    for (double v : values)
+      ++counts[static_cast<std::size_t>(
+          std::clamp(static_cast<int>((v - low) / width), 0, bins - 1))];
+    data << number(low) << " 0\n";
+    for (int b = 0; b < bins; ++b)
+      data << number(low + b * width) << ' ' << counts[b] << '\n';
+    data << number(high) << ' ' << counts.back() << '\n' << number(high) << " 0\n\n\n";
+  }
+  std::ostringstream commands;
+  commands << labels(title, xlabel, "count") << "set yrange [0:*]\nplot ";
+  for (std::size_t i = 0; i < series.size(); ++i)
+    commands << (i ? ", \\\n     " : "") << "data index " << i
+             << " using 1:2 with steps lw 2 title " << quoted(series[i].first);
+  commands << "\n";
+  return render(path, data.str(), commands.str());
+}
+
+fs::path xy_lines(const fs::path& path, const std::string& title, const std::string& xlabel,
+                  const std::string& ylabel, const std::vector<Series>& series, bool logx,
+                  bool logy) {
+  if (series.empty()) throw std::invalid_argument("plot '" + title + "': no series");
+  std::ostringstream data;
+  for (const Series& s : series) {
+    if (s.x.empty()) throw std::invalid_argument("series '" + s.name + "' is empty");
+    if (s.x.size() != s.y.size())
+      throw std::invalid_argument("series '" + s.name + "' has " + std::to_string(s.x.size()) +
+                                  " x values and " + std::to_string(s.y.size()) + " y values");
+    require_plottable(s.name, s.x, "x", logx);
+    require_plottable(s.name, s.y, "y", logy);
+    for (std::size_t i = 0; i < s.x.size(); ++i)
+      data << number(s.x[i]) << ' ' << number(s.y[i]) << '\n';
+    data << "\n\n";
+  }
+  std::ostringstream commands;
+  commands << labels(title, xlabel, ylabel) << (logx ? "set logscale x\n" : "")
+           << (logy ? "set logscale y\n" : "") << "plot ";
+  for (std::size_t i = 0; i < series.size(); ++i)
+    commands << (i ? ", \\\n     " : "") << "data index " << i
+             << " using 1:2 with linespoints lw 2 pt 7 ps 0.7 title " << quoted(series[i].name);
+  commands << "\n";
+  return render(path, data.str(), commands.str());
+}
+
+namespace {
+
+// The points no other point beats on both speed and accuracy, in increasing speed.
+std::vector<ParetoPoint> pareto_front(std::vector<ParetoPoint> points) {
+  std::sort(points.begin(), points.end(), [](const ParetoPoint& a, const ParetoPoint& b) {
+    return a.steps_per_second != b.steps_per_second ? a.steps_per_second > b.steps_per_second
+                                                    : a.rel_error < b.rel_error;
+  });
+  std::vector<ParetoPoint> front;
+  for (const ParetoPoint& p : points)
+    if (front.empty() || p.rel_error < front.back().rel_error) front.push_back(p);
+  std::reverse(front.begin(), front.end());
+  return front;
+}
+
+// A data file column holding a label: double-quoted, so a double quote inside becomes a single one;
+// a line break would end the record, a tab would show as a gap.
+std::string label_column(const std::string& label) {
+  std::string out = label;
+  std::replace(out.begin(), out.end(), '"', '\'');
+  for (char& c : out)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  return "\"" + out + "\"";
+}
+
+}  // namespace
+
+fs::path pareto(const fs::path& path, const std::string& title,
+                const std::vector<ParetoPoint>& points) {
+  if (points.empty()) throw std::invalid_argument("pareto plot '" + title + "': no points");
+  constexpr double kFrameRate = 60, kHapticRate = 1000;  // steps/s a simulator must reach
+  // The x range always shows both rates, so every point reads against them.
+  double x_low = kFrameRate, x_high = kHapticRate;
+  std::ostringstream data;
+  for (const ParetoPoint& p : points) {
+    require_plottable(p.label, {p.steps_per_second}, "steps_per_second", true);
+    require_plottable(p.label, {p.rel_error}, "rel_error", true);
+    x_low = std::min(x_low, p.steps_per_second);
+    x_high = std::max(x_high, p.steps_per_second);
+    data << number(p.steps_per_second) << ' ' << number(p.rel_error) << ' ' << label_column(p.label)
+         << '\n';
+  }
+  data << "\n\n";
+  for (const ParetoPoint& p : pareto_front(points))
+    data << number(p.steps_per_second) << ' ' << number(p.rel_error) << '\n';
+  std::ostringstream commands;
+  commands << labels(title, "steps per second", "relative error")
+           << "set logscale xy\n"
+           // Room on the right for the labels of the fastest points.
+           << "set xrange [" << number(x_low / 2) << ":" << number(x_high * 4) << "]\n";
+  const std::pair<double, const char*> rates[] = {{kFrameRate, "60 Hz"}, {kHapticRate, "1 kHz"}};
+  for (const auto& [rate, text] : rates)
+    commands << "set arrow from " << rate << ", graph 0 to " << rate
+             << ", graph 1 nohead dt 2 lw 1.5 lc 'gray30'\n"
+             << "set label " << quoted(text) << " at " << rate
+             << ", graph 0.96 offset char 0.5,0 left tc 'gray30'\n";
+  commands
+      << "plot data index 1 using 1:2 with lines dt 3 lw 1.5 lc 'gray50' title 'Pareto front', "
+         "\\\n     data index 0 using 1:2 with points pt 7 ps 1.3 lc 'royalblue' "
+         "title 'configurations', \\\n     data index 0 using 1:2:3 with labels offset "
+         "char 0.8,0.6 left font ',9' notitle\n";
+  return render(path, data.str(), commands.str());
+}
+
+}  // namespace msfem::compare

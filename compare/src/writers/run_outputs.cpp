@@ -1,0 +1,212 @@
+// The files of a run: for scripts (summary.json), for people (report.md with plots), for ParaView
+// (surface_<variant>.vtu + surfaces.pvd, fem.pvd; fem.xdmf + fem.h5 for XDMF readers) and for
+// analysis (fields.h5).
+#include "msfem/compare/writers/run_outputs.hpp"
+#include "msfem/compare/writers/run_summary.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/writers/fields_h5.hpp"
+#include "msfem/compare/writers/plots.hpp"
+#include "msfem/compare/writers/vtu.hpp"
+#include "msfem/fem_reference/elasticity_problem.hpp"
+
+namespace msfem::compare {
+namespace {
+
+void write_surfaces(const CaseRun& run, const std::filesystem::path& dir) {
+  const auto& s = run.problem.surface;
+  std::vector<std::pair<std::string, std::string>> datasets;
+  write_surface_vtu(dir / "surface_fem.vtu", s.vertices, s.triangles,
+                    {{"displacement", run.fem.surface_displacement}});
+  datasets.emplace_back("surface_fem.vtu", "fem");
+  for (const auto& v : run.variants) {
+    const std::string file = "surface_" + v.name + ".vtu";
+    write_surface_vtu(dir / file, s.vertices, s.triangles,
+                      {{"displacement", v.surface_displacement},
+                       {"fem_displacement", run.fem.surface_displacement},
+                       {"error", v.error},
+                       {"error_magnitude", v.error.rowwise().norm()}});
+    datasets.emplace_back(file, v.name);
+  }
+  write_pvd(dir / "surfaces.pvd", datasets);
+  // The FEM volume with its vertex displacements (for P2 the edge-midpoint values are left out).
+  write_volume_vtu(dir / "fem.vtu", run.mesh.vertices, run.mesh.tetrahedra,
+                   {{"displacement", run.fem.vertex_displacement}});
+  write_pvd(dir / "fem.pvd", {{"fem.vtu", "fem"}});
+  // The same volume field through deal.II's HDF5 + XDMF writer (also when the FEM came from the
+  // cache: the vertex displacements are all it needs).
+  fem_reference::write_vertex_displacement_hdf5(run.mesh, run.fem.vertex_displacement, dir, "fem");
+}
+
+void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
+  FemField fem;
+  fem.vertices = run.mesh.vertices;
+  fem.tetrahedra = run.mesh.tetrahedra;
+  fem.displacement = run.fem.vertex_displacement;
+  std::vector<VariantField> variants;
+  for (const auto& v : run.variants)
+    variants.push_back({v.name, v.surface_displacement, v.error});
+  write_fields_h5(dir / "fields.h5", run.problem.surface.vertices, run.problem.surface.triangles,
+                  fem, variants);
+}
+
+// Plots are an addition to the numbers: without gnuplot the report says so instead.
+std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::path& dir) {
+  std::vector<std::string> lines;
+  if (!gnuplot_available()) {
+    lines.push_back("(plots skipped: gnuplot is not installed)");
+    return lines;
+  }
+  std::vector<std::pair<std::string, Eigen::VectorXd>> histogram_series;
+  for (const auto& v : run.variants) {
+    Eigen::VectorXd e(run.compared_vertices.size());
+    for (std::size_t i = 0; i < run.compared_vertices.size(); ++i)
+      e[i] = 1e3 * v.error.row(run.compared_vertices[i]).norm();
+    histogram_series.emplace_back(v.name, e);
+  }
+  if (!histogram_series.empty()) {
+    const auto file = histogram(dir / "error_histogram.png", "Surface error magnitude per variant",
+                                "|u - u_FEM| (mm)", histogram_series, 30);
+    lines.push_back("![error histogram](" + file.filename().string() + ")");
+  }
+  if (!run.fem_force_depth.empty()) {
+    std::vector<Series> series;
+    Series fem{"FEM", {}, {}};
+    for (const auto& p : run.fem_force_depth) {
+      fem.x.push_back(1e3 * p.depth_m);
+      fem.y.push_back(p.force_n.norm());
+    }
+    series.push_back(fem);
+    for (const auto& v : run.variants) {
+      Series s{v.name, {}, {}};
+      for (const auto& p : v.force_depth) {
+        s.x.push_back(1e3 * p.depth_m);
+        s.y.push_back(p.force_n.norm());
+      }
+      series.push_back(s);
+    }
+    const auto file = xy_lines(dir / "force_depth.png", "Tool force against indentation depth",
+                               "depth (mm)", "|F| (N)", series, false, false);
+    lines.push_back("![force-depth curve](" + file.filename().string() + ")");
+  }
+  return lines;
+}
+
+// Each tool position of the case as its own load: rel L2 and force error per variant, and means.
+std::string tool_positions_table(const CaseRun& run) {
+  if (run.other_tools.empty()) return "";
+  std::ostringstream md;
+  md << "\n## Every tool position (rel L2 / force err)\n\n| variant |";
+  const int tools = static_cast<int>(run.other_tools.size()) + 1;
+  for (int t = 0; t < tools; ++t) {
+    const Eigen::Vector3d d = run.problem.parameters.loads.tool.directions[t];
+    char head[96];
+    std::snprintf(head, sizeof head, " tool %d (%.2g, %.2g, %.2g) |", t, d.x(), d.y(), d.z());
+    md << head;
+  }
+  md << " mean |\n|---|";
+  for (int t = 0; t <= tools; ++t)
+    md << "---|";
+  md << "\n";
+  for (const auto& v : run.variants) {
+    double l2 = 0.0, force = 0.0;
+    char cell[64];
+    md << "| " << v.name << " |";
+    for (const ToolLoadVariant& o : per_tool(run, v)) {
+      std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
+                    o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
+      md << cell;
+      l2 += o.errors.all.rel_l2_error;
+      force += o.reaction_force_rel_error;
+    }
+    std::snprintf(cell, sizeof cell, " %.3f / %.3f |", l2 / tools, force / tools);
+    md << cell << "\n";
+  }
+  md << "\nTool 0 is the load of the tables above; each other tool presses alone to the same depth "
+        "along the same loading path, on the same FEM mesh (refined at every tool). † the force "
+        "does not grow with depth along that tool's path (see the warnings).\n";
+  return md.str();
+}
+
+std::string report_markdown(const CaseRun& run, const std::vector<std::string>& plots) {
+  const auto& p = run.problem.parameters;
+  std::ostringstream md;
+  md << "# msfem run: " << p.name << "\n\n"
+     << "- case file: `" << p.file.string() << "`\n"
+     << "- surface: `" << p.geometry.source << "`, " << run.problem.surface.num_vertices()
+     << " vertices, " << run.problem.surface.num_triangles() << " triangles\n"
+     << "- material: E = " << p.material.youngs_modulus_pa
+     << " Pa, ν = " << p.material.poisson_ratio << ", ρ = " << p.material.density_kg_per_m3
+     << " kg/m³\n"
+     << "- FEM: P" << p.fem.degree << ", " << run.fem.statistics.dofs << " dofs, "
+     << run.fem.statistics.cells << " cells, " << run.fem.statistics.iterations << " iterations, "
+     << run.fem.statistics.solve_time_s << " s solve";
+  if (run.worst_cell_quality) md << ", worst cell quality " << *run.worst_cell_quality;
+  md << "\n"
+     << "- errors over " << run.compared_vertices.size()
+     << " surface vertices not prescribed by a support or the tool\n"
+     << "- FEM result " << (run.fem_from_cache ? "reused from the cache" : "computed") << " (key "
+     << run.fem_cache_key << ")\n"
+     << "- git " << git_revision() << ", " << machine_description() << "\n";
+  // Variants of the same name differ with and without it: say which tables are which.
+  std::string with_volume;
+  for (const auto& v : run.variants)
+    if (v.parameters.contains("volume_preservation"))
+      with_volume +=
+          (with_volume.empty() ? "" : ", ") + v.name + " (mean κ " +
+          std::to_string(v.parameters["volume_preservation"]["mean_modulus_pa"].get<double>()) +
+          " Pa)";
+  md << "- volume preservation: " << (with_volume.empty() ? "off" : with_volume) << "\n\n";
+  for (const auto& n : run.problem.notes)
+    md << "> note: " << n << "\n";
+  md << "\n## Variants\n\n"
+     << variant_table(run) << "\n"
+     << "rel L2 = ‖u − v‖₂/‖v‖₂ over the compared vertices; force = |tool reaction|; force err = "
+        "|F − F_FEM|/|F_FEM|; steps/s of the `"
+     << massspring::to_string(p.timing.integrator)
+     << "` integrator (median after warm-up); ms/frame = wall ms per 1/60 s "
+        "of simulated time.\n\n";
+  md << "| variant | contact zone rel L2 | far field rel L2 | mean err / max disp | volume change "
+        "| "
+        "settle time s |\n|---|---|---|---|---|---|\n";
+  for (const auto& v : run.variants) {
+    char row[256], settle[64] = "-";
+    if (!v.timing.integrator.empty())
+      std::snprintf(settle, sizeof settle, "%.3f%s", v.timing.settle_time_s,
+                    v.timing.settled ? "" : " (not settled)");
+    std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %s |\n", v.name.c_str(),
+                  v.errors.contact_zone.rel_l2_error, v.errors.far_field.rel_l2_error,
+                  v.errors.all.mean_error_over_max_disp, v.volume_change, settle);
+    md << row;
+  }
+  md << tool_positions_table(run);
+  for (const auto& v : run.variants)
+    for (const auto& w : v.warnings)
+      md << "\n> " << v.name << ": " << w << "\n";
+  for (const auto& [name, why] : run.failed_variants)
+    md << "\n> **" << name << " failed** and is left out of the tables and plots: " << why << "\n";
+  md << "\n## Plots\n\n";
+  for (const auto& l : plots)
+    md << l << "\n\n";
+  md << "## Files\n\n- `summary.json`: every number above\n"
+        "- `surfaces.pvd`: the surface of each variant with displacement, error vector and "
+        "magnitude (ParaView)\n- `fem.pvd`: the FEM solution\n"
+        "- `fem.xdmf` + `fem.h5`: the FEM solution for XDMF readers (ParaView, VisIt, h5py)\n"
+        "- `fields.h5`: FEM volume field, per-variant surface displacement and error\n";
+  return md.str();
+}
+
+}  // namespace
+
+void write_run_outputs(const CaseRun& run, const std::filesystem::path& directory) {
+  write_surfaces(run, directory);
+  write_fields(run, directory);
+  const auto plots = write_plots(run, directory);
+  write_text_atomically(directory / "report.md", report_markdown(run, plots));
+  write_text_atomically(directory / "summary.json", summary_json(run).dump(2) + "\n");
+}
+
+}  // namespace msfem::compare

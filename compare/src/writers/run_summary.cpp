@@ -1,0 +1,398 @@
+// The run's numbers as JSON and as a table: the interface users' scripts and CI read.
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "msfem/cases/setting_names.hpp"
+#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/writers/run_summary.hpp"
+
+namespace msfem::compare {
+namespace {
+
+nlohmann::json vec(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+nlohmann::json optional_vec(const std::optional<Eigen::Vector3d>& v) {
+  return v ? vec(*v) : nlohmann::json();
+}
+
+// The reference's own error at load `load` (nulls where it was not estimated or, for the force,
+// where no force is measured).
+nlohmann::json estimate_at(const CaseRun& run, std::size_t load) {
+  LoadErrorEstimate e;
+  if (load < run.fem_error.loads.size()) e = run.fem_error.loads[load];
+  return {{"estimated_rel_l2_error", json_or_null(e.rel_l2_error)},
+          {"estimated_force_rel_error", json_or_null(e.force_rel_error)}};
+}
+
+nlohmann::json zone(const ErrorMetrics& m) {
+  return {
+      {"rel_l2_error", m.rel_l2_error}, {"max_error_m", m.max_error_m}, {"vertices", m.vertices}};
+}
+
+nlohmann::json curve_json(const std::vector<ForceDepthPoint>& curve) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& pt : curve)
+    points.push_back({{"depth_m", pt.depth_m},
+                      {"force_N", vec(pt.force_n)},
+                      {"inverted_elements", json_or_null(pt.inverted_elements)}});
+  return points;
+}
+
+nlohmann::json contact_json(const std::optional<fem_reference::ContactReport>& c) {
+  if (!c) return nullptr;
+  return {{"active_nodes", c->active_nodes},
+          {"active_set_iterations", c->iterations},
+          {"contact_radius_m", c->contact_radius},
+          {"outermost_contact_node_radius_m", c->outermost_node_radius},
+          {"max_penetration_m", c->max_penetration}};
+}
+
+std::optional<ToolPlacement> tool_of(const CaseRun& run, int load) {
+  if (load >= static_cast<int>(run.problem.tools.size())) return std::nullopt;
+  return run.problem.tools[static_cast<std::size_t>(load)];
+}
+
+// The local point distribution at the tools; null where the surface is the case's own.
+nlohmann::json refinement_json(const Problem& problem) {
+  if (!problem.local_refinement) return nullptr;
+  const LocalRefinement& r = *problem.local_refinement;
+  return {{"radius_m", r.radius_m},
+          {"edge_length_m", r.edge_m},
+          {"added_surface_vertices", r.added_vertices}};
+}
+
+nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o) {
+  const ZonedErrorMetrics& e = o.errors;
+  return {{"tool", tool},
+          {"not_resolved_by_reference", unresolved_metrics(run, o, tool)},
+          {"rel_l2_error", e.all.rel_l2_error},
+          {"rms_error_m", e.all.rms_error_m},
+          {"max_error_m", e.all.max_error_m},
+          {"mean_error_over_max_disp", e.all.mean_error_over_max_disp},
+          {"contact_zone", zone(e.contact_zone)},
+          {"far_field", zone(e.far_field)},
+          {"reaction_force_N", vec(o.tool_force)},
+          {"reaction_force_rel_error", o.reaction_force_rel_error},
+          {"volume_change", o.volume_change},
+          {"inverted_elements", json_or_null(o.inverted_elements)},
+          {"force_depth_monotone", json_or_null(o.force_depth_monotone)},
+          {"force_depth_exponent",
+           json_or_null(force_depth_exponent(o.force_depth, tool_of(run, tool)))},
+          {"force_depth", curve_json(o.force_depth)}};
+}
+
+// Every tool position of the case as its own load (the first is the variant's own row), with the
+// means a user comparing variants over the case wants.
+nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
+  nlohmann::json list = nlohmann::json::array();
+  double l2 = 0.0, force = 0.0;
+  const std::vector<ToolLoadVariant> loads = per_tool(run, v);
+  for (std::size_t t = 0; t < loads.size(); ++t) {
+    list.push_back(load_json(run, static_cast<int>(t), loads[t]));
+    l2 += loads[t].errors.all.rel_l2_error;
+    force += loads[t].reaction_force_rel_error;
+  }
+  const double n = static_cast<double>(loads.size());
+  return {{"per_tool", list},
+          {"mean_rel_l2_error", l2 / n},
+          {"mean_reaction_force_rel_error", force / n}};
+}
+
+std::string command_output(const std::string& command) {
+  std::array<char, 256> buffer{};
+  std::string out;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+  if (!pipe) return "";
+  while (fgets(buffer.data(), buffer.size(), pipe.get()))
+    out += buffer.data();
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r'))
+    out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+std::string git_revision() {
+  const std::string source = std::filesystem::path(MSFEM_DEFAULT_CASES_DIR).parent_path().string();
+  const std::string rev =
+      command_output("git -C '" + source + "' describe --always --dirty 2>/dev/null");
+  return rev.empty() ? "unknown" : rev;
+}
+
+std::string machine_description() {
+  std::array<char, 256> host{};
+  gethostname(host.data(), host.size() - 1);
+  std::string cpu = "unknown CPU";
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);)
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  return std::string(host.data()) + ", " + cpu + ", " +
+         std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+}
+
+namespace {
+
+// The reference: its solve, its own error estimate, its force-depth curve and contact, per load.
+nlohmann::json fem_json(const CaseRun& run) {
+  const auto& p = run.problem.parameters;
+  const auto& st = run.fem.statistics;
+  nlohmann::json fem = {
+      {"degree", p.fem.degree},
+      {"dofs", st.dofs},
+      {"cells", st.cells},
+      {"vertices", st.vertices},
+      {"solve_time_s", st.solve_time_s},
+      {"assemble_time_s", st.assemble_time_s},
+      {"iterations", st.iterations},
+      {"solver", run.fem.solver.empty() ? cases::name_of(p.fem.solver) : run.fem.solver},
+      {"mpi_ranks", st.mpi_ranks},
+      {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(run.fem.tool_force)},
+      {"volume_change", run.fem.volume_change},
+      {"worst_cell_quality", json_or_null(run.worst_cell_quality)},
+      {"cache_key", run.fem_cache_key},
+      {"from_cache", run.fem_from_cache},
+      {"error_estimate",
+       {{"method", run.fem_error.method},
+        {"note", run.fem_error.note},
+        {"dofs", run.fem_error.dofs},
+        {"time_s", run.fem_error.time_s}}}};
+  fem.update(estimate_at(run, 0));
+  const std::vector<int> patch = patch_vertices(run.problem);
+  fem["patch_mean_displacement_m"] =
+      patch.empty() ? nlohmann::json()
+                    : vec(mean_displacement(run.fem.surface_displacement, patch));
+  nlohmann::json curve = nlohmann::json::array();
+  for (const auto& pt : run.fem_force_depth)
+    curve.push_back({{"depth_m", pt.depth_m},
+                     {"force_N", vec(pt.force_n)},
+                     {"contact", contact_json(pt.contact)}});
+  fem["force_depth"] = curve;
+  fem["force_depth_monotone"] = json_or_null(run.fem_force_depth_monotone);
+  fem["force_depth_exponent"] =
+      json_or_null(force_depth_exponent(run.fem_force_depth, tool_of(run, 0)));
+  fem["contact"] = contact_json(run.fem.contact);
+
+  if (!run.other_tools.empty()) {
+    nlohmann::json loads = nlohmann::json::array();
+    loads.push_back({{"tool", 0},
+                     {"reaction_force_N", vec(run.fem.tool_force)},
+                     {"iterations", st.iterations},
+                     {"solve_time_s", st.solve_time_s},
+                     {"contact", contact_json(run.fem.contact)}});
+    loads.back().update(estimate_at(run, 0));
+    for (const auto& load : run.other_tools) {
+      loads.push_back({{"tool", load.tool},
+                       {"reaction_force_N", vec(load.fem.tool_force)},
+                       {"iterations", load.fem.statistics.iterations},
+                       {"solve_time_s", load.fem.statistics.solve_time_s},
+                       {"contact", contact_json(load.fem.contact)}});
+      loads.back().update(estimate_at(run, static_cast<std::size_t>(load.tool)));
+    }
+    fem["loads"] = loads;
+  }
+  return fem;
+}
+
+// One variant: its errors, force, timing, force-depth curve, and (with more tools) per load.
+nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
+  const nlohmann::json fd = curve_json(v.force_depth);
+  nlohmann::json j = {
+      {"name", v.name},
+      {"nodes", v.nodes},
+      {"springs", v.springs},
+      {"contact_refinement_added_nodes", json_or_null(v.refinement_added_nodes)},
+      {"rel_l2_error", v.errors.all.rel_l2_error},
+      {"rms_error_m", v.errors.all.rms_error_m},
+      {"max_error_m", v.errors.all.max_error_m},
+      {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
+      {"contact_zone", zone(v.errors.contact_zone)},
+      {"far_field", zone(v.errors.far_field)},
+      {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(v.tool_force)},
+      {"reaction_force_rel_error",
+       run.problem.tools.empty() ? nlohmann::json() : nlohmann::json(v.reaction_force_rel_error)},
+      {"volume_change", v.volume_change},
+      {"patch_mean_displacement_m", optional_vec(v.patch_mean_displacement)},
+      {"patch_displacement_rel_error", json_or_null(v.patch_displacement_rel_error)},
+      {"not_resolved_by_reference", unresolved_metrics(run, v)},
+      {"integrator", v.timing.integrator},
+      {"dt_s", v.timing.dt_s},
+      {"steps_per_second", v.timing.steps_per_second},
+      {"stable_dt_s", v.timing.stable_dt_s},
+      {"predicted_stable_dt_s", v.timing.predicted_stable_dt_s},
+      {"realtime_factor", v.timing.realtime_factor},
+      {"settle_time_s", v.timing.settle_time_s},
+      {"settled", v.timing.settled},
+      {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
+      {"newton_iterations", v.newton_iterations},
+      {"force_depth", fd},
+      {"force_depth_monotone", json_or_null(v.force_depth_monotone)},
+      {"force_depth_exponent", json_or_null(force_depth_exponent(v.force_depth, tool_of(run, 0)))},
+      {"inverted_elements", json_or_null(v.inverted_elements)},
+      {"warnings", v.warnings},
+      {"parameters", v.parameters}};
+  if (!run.other_tools.empty()) j["loads"] = variant_loads(run, v);
+  return j;
+}
+
+nlohmann::json tools_json(const CaseRun& run) {
+  nlohmann::json tools = nlohmann::json::array();
+  for (const auto& t : run.problem.tools)
+    tools.push_back({{"vertex", t.vertex},
+                     {"contact_point_m", vec(t.contact_point)},
+                     {"outward_normal", vec(t.outward_normal)},
+                     {"radius_m", t.radius},
+                     {"depth_m", t.depth},
+                     {"mode", t.frictionless ? "contact" : "bonded"}});
+  return tools;
+}
+
+}  // namespace
+
+nlohmann::json summary_json(const CaseRun& run) {
+  const auto& p = run.problem.parameters;
+  nlohmann::json variants = nlohmann::json::array();
+  for (const auto& v : run.variants)
+    variants.push_back(variant_json(run, v));
+  nlohmann::json failed = nlohmann::json::array();
+  for (const auto& [name, why] : run.failed_variants)
+    failed.push_back({{"name", name}, {"error", why}});
+  const nlohmann::json fem = fem_json(run);
+  const nlohmann::json tools = tools_json(run);
+  return {{"case", p.name},
+          {"case_file", p.file.string()},
+          {"git_revision", git_revision()},
+          {"machine", machine_description()},
+          {"units", {{"length", "m"}, {"force", "N"}, {"time", "s"}, {"stress", "Pa"}}},
+          {"material",
+           {{"youngs_modulus_pa", p.material.youngs_modulus_pa},
+            {"poisson_ratio", p.material.poisson_ratio},
+            {"density_kg_per_m3", p.material.density_kg_per_m3}}},
+          {"surface",
+           {{"source", p.geometry.source},
+            {"vertices", run.problem.surface.num_vertices()},
+            {"triangles", run.problem.surface.num_triangles()}}},
+          {"contact_refinement", refinement_json(run.problem)},
+          {"compared_vertices", run.compared_vertices.size()},
+          {"tools", tools},
+          {"notes", run.problem.notes},
+          {"fem", fem},
+          {"variants", variants},
+          {"failed_variants", failed},
+          {"wall_time_s", run.wall_time_s}};
+}
+
+namespace {
+
+// "0.1234", with ‡ where the reference's own error is within 3x of it.
+std::string error_cell(double error, bool unresolved) {
+  char cell[32];
+  std::snprintf(cell, sizeof cell, "%.4f%s", error, unresolved ? " ‡" : "");
+  return cell;
+}
+
+bool contains(const std::vector<std::string>& list, const std::string& item) {
+  return std::find(list.begin(), list.end(), item) != list.end();
+}
+
+// Below the table: the reference's own error, and the patch comparison of a patch-force load.
+std::string table_notes(const CaseRun& run) {
+  std::ostringstream out;
+  const FemErrorEstimate& e = run.fem_error;
+  const LoadErrorEstimate first = e.loads.empty() ? LoadErrorEstimate{} : e.loads.front();
+  if (first.rel_l2_error) {
+    char line[512];
+    std::snprintf(
+        line, sizeof line, "FEM reference's own error (%s; %zu DoFs, %.1f s): rel L2 %.4f, %s %s\n",
+        e.note.c_str(), e.dofs, e.time_s, *first.rel_l2_error,
+        run.problem.tools.empty() && !patch_vertices(run.problem).empty() ? "patch displacement"
+                                                                          : "force",
+        first.force_rel_error ? error_cell(*first.force_rel_error, false).c_str() : "-");
+    out << line;
+    if (std::any_of(run.variants.begin(), run.variants.end(),
+                    [&](const auto& v) { return !unresolved_metrics(run, v).empty(); }))
+      out << "‡ within 3x of the reference's own error: not resolved by this reference\n";
+  } else {
+    out << "FEM reference's own error: " << e.note << "\n";
+  }
+  const std::vector<int> patch = patch_vertices(run.problem);
+  if (!patch.empty()) {
+    const Eigen::Vector3d fem = mean_displacement(run.fem.surface_displacement, patch);
+    char line[256];
+    std::snprintf(line, sizeof line, "patch force on %zu vertices: mean displacement FEM %.3f mm",
+                  patch.size(), 1e3 * fem.norm());
+    out << line;
+    for (const auto& v : run.variants) {
+      std::snprintf(line, sizeof line, "; %s %.3f mm (err %s)", v.name.c_str(),
+                    1e3 * v.patch_mean_displacement->norm(),
+                    error_cell(*v.patch_displacement_rel_error,
+                               contains(unresolved_metrics(run, v), "patch_displacement_rel_error"))
+                        .c_str());
+      out << line;
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+std::string variant_table(const CaseRun& run) {
+  std::ostringstream out;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "| %-12s | %6s | %7s | %9s | %9s | %9s | %9s | %10s | %9s | %9s |\n", "variant",
+                "nodes", "springs", "rel L2", "max err mm", "force N", "force err", "steps/s",
+                "stable dt", "ms/frame");
+  out << line;
+  out << "|--------------|--------|---------|-----------|-----------|-----------|-----------|------"
+         "------|-----------|-----------|\n";
+  // Without a tool no force is measured: dashes, not a zero that reads as a perfect force.
+  const bool tool = !run.problem.tools.empty();
+  char fem_force[32] = "-";
+  if (tool) std::snprintf(fem_force, sizeof fem_force, "%.4g", run.fem.tool_force.norm());
+  std::snprintf(line, sizeof line,
+                "| %-12s | %6zu | %7s | %9s | %9s | %9s | %9s | %10s | %9s | %9s |\n",
+                ("FEM P" + std::to_string(run.problem.parameters.fem.degree)).c_str(),
+                static_cast<std::size_t>(run.fem.statistics.vertices), "-", "-", "-", fem_force,
+                "-", "-", "-", "-");
+  out << line;
+  for (const auto& v : run.variants) {
+    // Not timed (--no-timing): dashes, not zeros that read as measurements.
+    const bool timed = !v.timing.integrator.empty();
+    char steps[32] = "-", dt[32] = "-", frame[32] = "-", force[32] = "-";
+    if (timed) {
+      std::snprintf(steps, sizeof steps, "%.0f", v.timing.steps_per_second);
+      std::snprintf(dt, sizeof dt, "%.3g", v.timing.stable_dt_s);
+      std::snprintf(frame, sizeof frame, "%.3f", v.timing.ms_per_60hz_frame);
+    }
+    const std::vector<std::string> unresolved = unresolved_metrics(run, v);
+    std::string force_error = "-";
+    if (tool) {
+      std::snprintf(force, sizeof force, "%.4g", v.tool_force.norm());
+      force_error =
+          error_cell(v.reaction_force_rel_error, contains(unresolved, "reaction_force_rel_error"));
+    }
+    std::snprintf(
+        line, sizeof line, "| %-12s | %6d | %7d | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
+        v.name.c_str(), v.nodes, v.springs,
+        error_cell(v.errors.all.rel_l2_error, contains(unresolved, "rel_l2_error")).c_str(),
+        1e3 * v.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
+    out << line;
+  }
+  out << table_notes(run);
+  return out.str();
+}
+
+}  // namespace msfem::compare

@@ -1,0 +1,169 @@
+// A model is its springs plus a list of named force fields: a field a simulator adds joins every
+// ForceModel call (force, energy, both Jacobians, as products and as triplets), replaces a field of
+// its name in place, scales by its coefficient groups, and is refused by name where a solver
+// cannot run it.
+#include <gtest/gtest.h>
+
+#include "force_jacobian_check.hpp"
+#include "icosphere.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_implicit_stepper.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/linearised_statics.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/topology_builders.hpp"
+#include "msfem/massspring/volume_force_field.hpp"
+
+namespace msfem::massspring {
+namespace {
+
+using testing::check_force_jacobians;
+using testing::icosphere;
+using testing::perturbed;
+
+// Every node tied to its rest position by a spring k and a dashpot c: f = -k (x - X) - c v. Its
+// dashpot is what a field-blind ∂f/∂v would miss.
+class RestTether : public ForceField {
+ public:
+  RestTether(Eigen::VectorXd rest, double k, double c) : rest_(std::move(rest)), k_(k), c_(c) {}
+  int num_dofs() const override { return static_cast<int>(rest_.size()); }
+  void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                 Eigen::VectorXd& f) const override {
+    f -= k_ * (x - rest_) + c_ * v;
+  }
+  double potential_energy(const Eigen::VectorXd& x) const override {
+    return 0.5 * k_ * (x - rest_).squaredNorm();
+  }
+  void add_dfdx_product(const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd& dx,
+                        Eigen::VectorXd& df, Linearisation) const override {
+    df -= k_ * dx;
+  }
+  void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd& dv,
+                        Eigen::VectorXd& df) const override {
+    df -= c_ * dv;
+  }
+  void add_dfdx_triplets(const Eigen::VectorXd&, const Eigen::VectorXd&, Triplets& t,
+                         Linearisation) const override {
+    for (int i = 0; i < num_dofs(); ++i)
+      t.emplace_back(i, i, -k_);
+  }
+  void add_dfdv_triplets(const Eigen::VectorXd&, Triplets& t) const override {
+    for (int i = 0; i < num_dofs(); ++i)
+      t.emplace_back(i, i, -c_);
+  }
+  std::vector<int> nodes() const override {
+    std::vector<int> all(num_dofs() / 3);
+    for (int i = 0; i < num_dofs() / 3; ++i)
+      all[i] = i;
+    return all;
+  }
+  std::vector<std::string> coefficient_groups() const override { return {"tether"}; }
+  std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const override {
+    if (group != "tether") return ForceField::scaled(group, factor);
+    return std::make_shared<RestTether>(rest_, k_ * factor, c_);
+  }
+
+ private:
+  Eigen::VectorXd rest_;
+  double k_, c_;
+};
+
+MassSpringModel three_tier_model() {
+  const auto mesh = icosphere(1, 0.05);
+  MassSpringModel model(build_three_tier(mesh.vertices, mesh.triangles, ThreeTierOptions{}));
+  model.set_group_damping("tier1_edges", 0.01);
+  return model;
+}
+
+TEST(ForceFields, AFieldJoinsEveryForceModelCall) {
+  MassSpringModel model = three_tier_model();
+  const Eigen::VectorXd rest = model.rest_state();
+  const Eigen::VectorXd x = perturbed(rest, 0.002, 7), v = perturbed(0 * rest, 0.01, 8);
+  const Eigen::VectorXd dx = perturbed(0 * rest, 1.0, 9);
+  const MassSpringModel springs_only = model;
+  const double k = 40.0, c = 0.3;
+  model.set_field("tether", std::make_shared<RestTether>(rest, k, c));
+  ASSERT_EQ(model.fields().size(), 1u);
+  EXPECT_EQ(model.field_names(), "tether");
+
+  const Eigen::VectorXd extra = model.force(x, v) - springs_only.force(x, v);
+  EXPECT_LT((extra + k * (x - rest) + c * v).norm(), 1e-9 * (k * (x - rest)).norm());
+  EXPECT_NEAR(model.potential_energy(x) - springs_only.potential_energy(x),
+              0.5 * k * (x - rest).squaredNorm(), 1e-9);
+  Eigen::VectorXd with = Eigen::VectorXd::Zero(x.size()), without = with;
+  model.add_dfdv_product(x, dx, with);
+  springs_only.add_dfdv_product(x, dx, without);
+  EXPECT_LT((with - without + c * dx).norm(), 1e-12 * c * dx.norm());
+  const Eigen::SparseMatrix<double> dv = model.dfdv(x) - springs_only.dfdv(x);
+  EXPECT_LT((Eigen::MatrixXd(dv) + c * Eigen::MatrixXd::Identity(x.size(), x.size())).norm(),
+            1e-12);
+  // The composed model's Jacobians against finite differences.
+  const auto errors = check_force_jacobians(model, x, v, 1e-7);
+  EXPECT_LT(errors.dfdx_matrix, 1e-5);
+  EXPECT_LT(errors.dfdv_matrix, 1e-5);
+  EXPECT_LT(errors.dfdv_product, 1e-5);
+  EXPECT_LT(errors.energy_gradient, 1e-5);
+}
+
+TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByName) {
+  MassSpringModel model = three_tier_model();
+  const Eigen::VectorXd rest = model.rest_state(), x = perturbed(rest, 0.002, 3);
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  const MassSpringModel springs_only = model;
+  auto tether = std::make_shared<RestTether>(rest, 10.0, 0.0);
+  model.set_field("tether", tether);
+  const auto& nv = model.network().surface_nodes;
+  model.set_volume(VolumeForceField(
+      model.num_nodes(),
+      tier_prisms(model.network().rest_positions, model.network().surface_triangles,
+                  static_cast<int>(nv.size()), 3, 500.0)));
+  model.set_field("tether", tether->scaled("tether", 3.0));
+  ASSERT_EQ(model.field_names(), "tether, volume");  // replaced where it was
+  const MassSpringModel with_volume_only = [&] {
+    MassSpringModel m = model;
+    m.clear_field("tether");
+    return m;
+  }();
+  const Eigen::VectorXd tether_force = model.force(x, v) - with_volume_only.force(x, v);
+  EXPECT_LT((tether_force + 30.0 * (x - rest)).norm(), 1e-9 * 30.0 * (x - rest).norm());
+  EXPECT_THROW(tether->scaled("volume", 2.0), ModelError);
+  EXPECT_THROW(model.set_field("short", std::make_shared<RestTether>(rest.head(6), 1.0, 0.0)),
+               ModelError);
+  // Copies share fields but not the list: clearing one copy's leaves the other's.
+  EXPECT_EQ(springs_only.fields().size(), 0u);
+  EXPECT_NE(model.volume(), nullptr);
+}
+
+// The fast kernels step springs, anchors, gravity and loads: a field they would drop is refused,
+// by name; the linearised statics give each field its own weight.
+TEST(ForceFields, FastSteppersRefuseByNameAndLinearStaticsWeightEachField) {
+  MassSpringModel model = three_tier_model();
+  const Eigen::VectorXd rest = model.rest_state();
+  for (int node = 0; node < model.num_nodes(); ++node)
+    if (rest.segment<3>(3 * node).norm() < 0.03) model.fix_node(node);
+  model.set_gravity(Eigen::Vector3d(0, 0, -9.81));
+  EXPECT_NO_THROW(FastExplicitStepper{model});
+  model.set_field("tether", std::make_shared<RestTether>(rest, 50.0, 0.0));
+  for (const auto& construct : {+[](const MassSpringModel& m) { FastExplicitStepper s(m); },
+                                +[](const MassSpringModel& m) { FastImplicitStepper s(m); }}) {
+    try {
+      construct(model);
+      ADD_FAILURE() << "a fast stepper accepted a model with a field it does not step";
+    } catch (const ModelError& e) {
+      EXPECT_NE(std::string(e.what()).find("tether"), std::string::npos) << e.what();
+    }
+  }
+  // Under gravity alone the tether's weight w scales the displacement of a free node pinned by
+  // nothing else: with the springs' part weighted 0 and the tether's w, u = m g / (w k).
+  LinearisedStatics statics(model, {model.network().stiffness});
+  ASSERT_EQ(statics.num_parts(), 2);
+  const int node = model.network().surface_nodes.front();
+  const double m = model.network().masses[node];
+  for (const double w : {1.0, 4.0}) {
+    const auto s = statics.solve({1e-9, w}, {});
+    EXPECT_NEAR(s.surface_displacement(0, 2), -m * 9.81 / (w * 50.0), 1e-6 * m * 9.81 / 50.0);
+  }
+}
+
+}  // namespace
+}  // namespace msfem::massspring
