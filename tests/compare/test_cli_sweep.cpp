@@ -19,9 +19,10 @@ TEST(CliSweep, AResolutionThatCannotBeRunIsReportedAndTheOthersAreStillSwept) {
   // brain below ~2,500 vertices) it is bad input at that resolution only.
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
-  const auto r =
-      run_msfem("sweep " + small_case +
-                " --quiet --resolutions 1,10 --integrators symplectic_euler --out " + out.string());
+  const auto r = run_msfem("sweep " + small_case +
+                           " --quiet --resolutions 1,10 --integrators symplectic_euler "
+                           "--max-error 10 --out " +
+                           out.string());
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("resolution 10 failed"), std::string::npos) << r.err;
   const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
@@ -32,7 +33,24 @@ TEST(CliSweep, AResolutionThatCannotBeRunIsReportedAndTheOthersAreStillSwept) {
     EXPECT_EQ(p["resolution"], 1);
     EXPECT_GT(p["steps_per_second"].get<double>(), 0.0);
   }
-  EXPECT_NE(read_text(out / "report.md").find("resolution 10 failed"), std::string::npos);
+  const std::string report = read_text(out / "report.md");
+  EXPECT_NE(report.find("resolution 10 failed"), std::string::npos);
+  // The report opens with its answer; every point is within rel L2 10, so there is a cheapest.
+  EXPECT_LT(report.find("## Answer"), report.find("## Every configuration")) << report;
+  EXPECT_NE(report.find("| cheapest with rel L2 <= 10 | "), std::string::npos) << report;
+  EXPECT_EQ(report.find("| cheapest with rel L2 <= 10 | none"), std::string::npos) << report;
+}
+
+TEST(CliSweep, AMaximumErrorThatIsNotAPositiveNumberIsRefusedBeforeAnySolve) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "sweep";
+  for (const char* bad : {"0", "-0.1", "abc", "0.2x", "nan"}) {
+    const auto r =
+        run_msfem("sweep " + small_case + " --quiet --max-error " + bad + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("--max-error"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
 }
 
 TEST(CliSweep, WhenNoResolutionCanBeRunItIsAnErrorAndNothingIsWritten) {

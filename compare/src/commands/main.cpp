@@ -30,8 +30,10 @@ const std::vector<CommandEntry>& commands() {
        "      the FEM even if <output directory>/.fem-cache holds it)"},
       {"sweep", sweep_command,
        "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
-       "          [--quiet] [--json]\n"
-       "      variants x resolutions x integrators: sweep.json, table and Pareto plot"},
+       "          [--max-error E] [--quiet] [--json]\n"
+       "      variants x resolutions x integrators: sweep.json, report.md opening with the least-\n"
+       "      error configuration for a 60 Hz and a 1 kHz loop in real time (and the cheapest\n"
+       "      within rel L2 E), table and Pareto plot"},
       {"regress", regress_command,
        "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]... [--quiet]\n"
        "      compare runs with committed baselines; exit 1 on a worse metric or field, a missing\n"

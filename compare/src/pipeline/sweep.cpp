@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <sstream>
+#include <tuple>
 
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/cases/surface_generators.hpp"
@@ -76,6 +78,7 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
       pt.stable_dt_s = t.stable_dt_s;
       pt.steps_per_second = t.steps_per_second;
       pt.realtime_factor = t.realtime_factor;
+      pt.dt_s = t.dt_s;
       pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
       if (!run.fem_error.loads.empty()) {
         pt.fem_estimated_rel_l2_error = run.fem_error.loads.front().rel_l2_error;
@@ -135,6 +138,7 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
          {"stable_dt_s", p.stable_dt_s},
          {"steps_per_second", p.steps_per_second},
          {"realtime_factor", p.realtime_factor},
+         {"dt_s", p.dt_s},
          {"ms_per_60hz_frame", p.ms_per_60hz_frame},
          {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
          {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
@@ -181,6 +185,114 @@ std::string sweep_table(const std::vector<SweepPoint>& points) {
   }
   if (any_flag)
     out << "\n‡ within 3x of the reference's own error: not resolved by this reference\n";
+  return out.str();
+}
+
+std::vector<VariantConvergence> convergence_by_variant(const std::vector<SweepPoint>& points) {
+  std::vector<VariantConvergence> result;
+  for (const auto& p : points) {
+    auto it = std::find_if(result.begin(), result.end(),
+                           [&](const VariantConvergence& v) { return v.variant == p.variant; });
+    if (it == result.end()) it = result.insert(result.end(), {p.variant, {}, std::nullopt});
+    auto& at = it->error_at_vertices;
+    if (std::none_of(at.begin(), at.end(),
+                     [&](const auto& e) { return e.first == p.surface_vertices; }))
+      at.emplace_back(p.surface_vertices, p.rel_l2_error);
+  }
+  for (auto& v : result) {
+    auto& at = v.error_at_vertices;
+    std::sort(at.begin(), at.end());
+    if (at.size() >= 2 && at.front().second > 0 && at.back().second > 0)
+      v.observed_order = -2.0 * std::log(at.back().second / at.front().second) /
+                         std::log(double(at.back().first) / double(at.front().first));
+  }
+  return result;
+}
+
+std::string convergence_section(const std::vector<VariantConvergence>& convergence) {
+  std::ostringstream out;
+  out << "## Error against resolution\n\n| variant | rel L2 at surface vertices | observed order |"
+         "\n|---|---|---|\n";
+  std::string diverging;
+  char cell[64];
+  for (const auto& v : convergence) {
+    out << "| " << v.variant << " | ";
+    for (std::size_t i = 0; i < v.error_at_vertices.size(); ++i) {
+      std::snprintf(cell, sizeof cell, "%s%.4f @ %d", i ? ", " : "", v.error_at_vertices[i].second,
+                    v.error_at_vertices[i].first);
+      out << cell;
+    }
+    std::snprintf(cell, sizeof cell, "%.2f", v.observed_order.value_or(0.0));
+    out << " | " << (v.observed_order ? cell : "-") << " |\n";
+    if (v.observed_order && *v.observed_order < 0)
+      diverging += (diverging.empty() ? "" : ", ") + v.variant;
+  }
+  out << "\nObserved order p from e ∝ h^p, h ∝ N^(-1/2), between the coarsest and the finest "
+         "resolution. ";
+  if (!diverging.empty())
+    out << "**Not converging: " << diverging
+        << "** (the error grows as the model is refined: refining does not make this model "
+           "approach the FEM).";
+  out << "\n\n";
+  return out.str();
+}
+
+bool keeps_real_time(const SweepPoint& point, double rate_hz) {
+  if (!(point.dt_s > 0) || !(point.steps_per_second > 0)) return false;
+  const double steps_per_tick = std::ceil(1.0 / (rate_hz * point.dt_s) - 1e-9);
+  return point.steps_per_second >= rate_hz * steps_per_tick;
+}
+
+namespace {
+
+std::string configuration(const SweepPoint& p) {
+  return p.variant + ", " + p.integrator + ", resolution " + std::to_string(p.resolution) + " (" +
+         std::to_string(p.nodes) + " nodes)";
+}
+
+std::string answer_row(const std::string& budget, const SweepPoint* p) {
+  if (!p) return "| " + budget + " | none of the swept configurations | | | |\n";
+  char row[512];
+  std::snprintf(row, sizeof row, "| %s | %s | %.4f%s | %.4f%s | %.3g |\n", budget.c_str(),
+                configuration(*p).c_str(), p->rel_l2_error,
+                p->not_resolved_by_reference.empty() ? "" : " ‡", p->reaction_force_rel_error,
+                p->not_resolved_by_reference.empty() ? "" : " ‡", p->realtime_factor);
+  return row;
+}
+
+}  // namespace
+
+std::string sweep_answer(const std::vector<SweepPoint>& points, std::optional<double> max_error) {
+  auto least_error = [&](double rate) -> const SweepPoint* {
+    const SweepPoint* best = nullptr;
+    for (const auto& p : points)
+      if (keeps_real_time(p, rate) &&
+          (!best || std::tie(p.rel_l2_error, p.reaction_force_rel_error) <
+                        std::tie(best->rel_l2_error, best->reaction_force_rel_error)))
+        best = &p;
+    return best;
+  };
+  std::ostringstream out;
+  out << "## Answer\n\n"
+         "| budget | configuration | rel L2 | force err | real-time factor |\n"
+         "|---|---|---|---|---|\n"
+      << answer_row("least error, 60 Hz visual loop in real time", least_error(60.0))
+      << answer_row("least error, 1 kHz haptic loop in real time", least_error(1000.0));
+  if (max_error) {
+    const SweepPoint* cheapest = nullptr;
+    for (const auto& p : points)
+      if (p.rel_l2_error <= *max_error &&
+          (!cheapest || p.realtime_factor > cheapest->realtime_factor))
+        cheapest = &p;
+    char budget[96];
+    std::snprintf(budget, sizeof budget, "cheapest with rel L2 <= %g", *max_error);
+    out << answer_row(budget, cheapest);
+  }
+  out << "\nA loop of rate f keeps real time when each tick's ceil(1 / (f dt)) steps, at the step "
+         "dt the sweep timed (half the measured stable step), take at most 1/f s on this "
+         "machine. "
+      << (max_error ? "" : "`--max-error E` adds the cheapest configuration within rel L2 E. ")
+      << "‡: within 3x of the reference's own error, so not resolved by this reference.\n\n";
   return out.str();
 }
 

@@ -280,8 +280,8 @@ namespace {
 // The points no other point beats on both speed and accuracy, in increasing speed.
 std::vector<ParetoPoint> pareto_front(std::vector<ParetoPoint> points) {
   std::sort(points.begin(), points.end(), [](const ParetoPoint& a, const ParetoPoint& b) {
-    return a.steps_per_second != b.steps_per_second ? a.steps_per_second > b.steps_per_second
-                                                    : a.rel_error < b.rel_error;
+    return a.realtime_factor != b.realtime_factor ? a.realtime_factor > b.realtime_factor
+                                                  : a.rel_error < b.rel_error;
   });
   std::vector<ParetoPoint> front;
   for (const ParetoPoint& p : points)
@@ -302,40 +302,65 @@ std::string label_column(const std::string& label) {
 
 }  // namespace
 
+// The distinct values of a field of the points, in first-seen order.
+template <typename Field>
+std::vector<std::string> groups_of(const std::vector<ParetoPoint>& points, Field field) {
+  std::vector<std::string> groups;
+  for (const ParetoPoint& p : points)
+    if (std::find(groups.begin(), groups.end(), p.*field) == groups.end())
+      groups.push_back(p.*field);
+  return groups;
+}
+
 fs::path pareto(const fs::path& path, const std::string& title,
                 const std::vector<ParetoPoint>& points) {
   if (points.empty()) throw std::invalid_argument("pareto plot '" + title + "': no points");
-  constexpr double kFrameRate = 60, kHapticRate = 1000;  // steps/s a simulator must reach
-  // The x range always shows both rates, so every point reads against them.
-  double x_low = kFrameRate, x_high = kHapticRate;
+  const std::vector<std::string> colours = groups_of(points, &ParetoPoint::colour_group);
+  const std::vector<std::string> markers = groups_of(points, &ParetoPoint::marker_group);
+  static const int marker_types[] = {7, 5, 9, 11, 13, 15, 4, 6};  // filled circle, square, ...
+  // The x range always shows real time, so every point reads against it.
+  double x_low = 1.0, x_high = 1.0;
   std::ostringstream data;
-  for (const ParetoPoint& p : points) {
-    require_plottable(p.label, {p.steps_per_second}, "steps_per_second", true);
-    require_plottable(p.label, {p.rel_error}, "rel_error", true);
-    x_low = std::min(x_low, p.steps_per_second);
-    x_high = std::max(x_high, p.steps_per_second);
-    data << number(p.steps_per_second) << ' ' << number(p.rel_error) << ' ' << label_column(p.label)
-         << '\n';
+  for (const std::string& group : colours) {  // data block per colour group
+    for (const ParetoPoint& p : points) {
+      if (p.colour_group != group) continue;
+      require_plottable(p.label, {p.realtime_factor}, "realtime_factor", true);
+      require_plottable(p.label, {p.rel_error}, "rel_error", true);
+      x_low = std::min(x_low, p.realtime_factor);
+      x_high = std::max(x_high, p.realtime_factor);
+      const auto m = std::find(markers.begin(), markers.end(), p.marker_group) - markers.begin();
+      data << number(p.realtime_factor) << ' ' << number(p.rel_error) << ' ' << marker_types[m % 8]
+           << ' ' << (p.ringed ? 1 : 0) << '\n';
+    }
+    data << "\n\n";
   }
-  data << "\n\n";
   for (const ParetoPoint& p : pareto_front(points))
-    data << number(p.steps_per_second) << ' ' << number(p.rel_error) << '\n';
+    data << number(p.realtime_factor) << ' ' << number(p.rel_error) << ' ' << label_column(p.label)
+         << '\n';
+  const std::size_t front = colours.size();
   std::ostringstream commands;
-  commands << labels(title, "steps per second", "relative error")
-           << "set logscale xy\n"
-           // Room on the right for the labels of the fastest points.
-           << "set xrange [" << number(x_low / 2) << ":" << number(x_high * 4) << "]\n";
-  const std::pair<double, const char*> rates[] = {{kFrameRate, "60 Hz"}, {kHapticRate, "1 kHz"}};
-  for (const auto& [rate, text] : rates)
-    commands << "set arrow from " << rate << ", graph 0 to " << rate
-             << ", graph 1 nohead dt 2 lw 1.5 lc 'gray30'\n"
-             << "set label " << quoted(text) << " at " << rate
-             << ", graph 0.96 offset char 0.5,0 left tc 'gray30'\n";
-  commands
-      << "plot data index 1 using 1:2 with lines dt 3 lw 1.5 lc 'gray50' title 'Pareto front', "
-         "\\\n     data index 0 using 1:2 with points pt 7 ps 1.3 lc 'royalblue' "
-         "title 'configurations', \\\n     data index 0 using 1:2:3 with labels offset "
-         "char 0.8,0.6 left font ',9' notitle\n";
+  commands << labels(title, "real-time factor (simulated s per wall s)", "relative error")
+           << "set logscale xy\nset key outside right top\n"
+           << "set xrange [" << number(x_low / 2) << ":" << number(x_high * 4) << "]\n"
+           << "set arrow from 1, graph 0 to 1, graph 1 nohead dt 2 lw 1.5 lc 'gray30'\n"
+           << "set label 'real time' at 1, graph 0.96 offset char 0.5,0 left tc 'gray30'\n"
+           << "plot data index " << front
+           << " using 1:2 with lines dt 2 lw 2 lc 'gray40' title 'Pareto front'";
+  // The legend: a filled square per colour, then a black marker per marker group.
+  for (std::size_t c = 0; c < colours.size(); ++c)
+    commands << ", \\\n     data index " << c << " using 1:2:3 with points pt variable ps 1.3 lc "
+             << c + 1 << " notitle, \\\n     NaN with points pt 5 ps 1.3 lc " << c + 1
+             << " title " << quoted(colours[c].empty() ? "configurations" : colours[c]);
+  for (std::size_t m = 0; m < markers.size() && markers.size() > 1; ++m)
+    commands << ", \\\n     NaN with points pt " << marker_types[m % 8]
+             << " ps 1.3 lc 'black' title " << quoted(markers[m]);
+  if (std::any_of(points.begin(), points.end(), [](const ParetoPoint& p) { return p.ringed; }))
+    for (std::size_t c = 0; c < colours.size(); ++c)
+      commands << ", \\\n     data index " << c
+               << " using 1:($4 > 0 ? $2 : NaN) with points pt 6 ps 2.6 lw 1.5 lc 'black' "
+               << (c == 0 ? "title '1 kHz in real time'" : "notitle");
+  commands << ", \\\n     data index " << front
+           << " using 1:2:3 with labels offset char 0.8,0.6 left font ',9' notitle\n";
   return render(path, data.str(), commands.str());
 }
 

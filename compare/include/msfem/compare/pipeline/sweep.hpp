@@ -28,6 +28,7 @@ struct SweepPoint {
   int nodes = 0, springs = 0;
   double rel_l2_error = 0.0, reaction_force_rel_error = 0.0;
   double stable_dt_s = 0.0, steps_per_second = 0.0, realtime_factor = 0.0;
+  double dt_s = 0.0;  ///< the step steps/s was timed at (half the stable one)
   double ms_per_60hz_frame = 0.0;
   /// The resolution's FEM reference's own error (fem/error estimate; none where not estimated)
   /// and the variant's metrics within 3x of it.
@@ -49,5 +50,27 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
 
 nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result);
 std::string sweep_table(const std::vector<SweepPoint>& points);
+
+/// Whether the point keeps a loop of `rate_hz` in real time at the step it was timed at: each
+/// tick of 1/rate s takes ceil(1 / (rate dt)) steps, which must fit in the tick.
+bool keeps_real_time(const SweepPoint& point, double rate_hz);
+
+/// The sweep's answer, markdown: for a 60 Hz visual loop and a 1 kHz haptic loop in real time,
+/// the least-error configuration that keeps it (rel L2, then force error); with `max_error`, the
+/// cheapest configuration (largest real-time factor) within that rel L2.
+std::string sweep_answer(const std::vector<SweepPoint>& points, std::optional<double> max_error);
+
+/// A variant's error at each swept resolution (the error does not depend on the integrator) and
+/// its observed order p, e ∝ h^p with h ∝ N^(-1/2) for N surface vertices, from the coarsest to
+/// the finest resolution; none with fewer than two resolutions.
+struct VariantConvergence {
+  std::string variant;
+  std::vector<std::pair<int, double>>
+      error_at_vertices;  ///< (surface vertices, rel L2), coarse first
+  std::optional<double> observed_order;
+};
+std::vector<VariantConvergence> convergence_by_variant(const std::vector<SweepPoint>& points);
+/// The convergence as a markdown section, saying which variants do not converge.
+std::string convergence_section(const std::vector<VariantConvergence>& convergence);
 
 }  // namespace msfem::compare

@@ -26,8 +26,11 @@ struct Series {
 /// One configuration on the accuracy-versus-speed plane.
 struct ParetoPoint {
   std::string label;
-  double steps_per_second = 0.0;
+  double realtime_factor = 0.0;  ///< simulated seconds per wall second
   double rel_error = 0.0;
+  std::string colour_group;  ///< one colour per group (the variant); empty: one group
+  std::string marker_group;  ///< one marker per group (the integrator); empty: one marker
+  bool ringed = false;       ///< marked with a ring (e.g. can run a 1 kHz loop in real time)
 };
 
 /// Histograms of error magnitudes (one series per variant, metres), drawn as overlaid step outlines
@@ -43,9 +46,10 @@ std::filesystem::path xy_lines(const std::filesystem::path& path, const std::str
                                const std::string& xlabel, const std::string& ylabel,
                                const std::vector<Series>& series, bool logx, bool logy);
 
-/// Accuracy versus speed, log-log: x = steps per second, y = relative error, each point labelled,
-/// the Pareto front (no other point both faster and more accurate) joined, and vertical lines at
-/// 60 steps/s ("60 Hz", a rendered frame) and 1000 steps/s ("1 kHz", haptics).
+/// Accuracy versus speed, log-log: x = real-time factor, y = relative error, a colour per colour
+/// group and a marker per marker group (both in the legend), the Pareto front (no other point both
+/// faster and more accurate) joined and only its points labelled, ringed points marked, and a
+/// vertical line at real time (x = 1).
 std::filesystem::path pareto(const std::filesystem::path& path, const std::string& title,
                              const std::vector<ParetoPoint>& points);
 
