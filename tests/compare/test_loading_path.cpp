@@ -46,6 +46,33 @@ BuiltVariant one_tetrahedron() {
   return b;
 }
 
+// A tool pressing along -z (outward normal +z): the axial force is f_z, the lateral |(f_x, f_y)|.
+TEST(BucklingOnset, TheFirstDepthWhereTheForceStopsGrowingOrTurnsSideways) {
+  ToolPlacement tool;
+  tool.outward_normal = Eigen::Vector3d::UnitZ();
+  tool.depth = 0.005;
+  auto at = [](double depth, double fx, double fz) {
+    return ForceDepthPoint{depth, Eigen::Vector3d(fx, 0, fz), {}, {}};
+  };
+  // Hertz-like and straight: neither.
+  const BucklingOnset straight = buckling_onset(
+      {at(0.001, 0.0, 0.01), at(0.002, 0.001, 0.03), at(0.003, 0.002, 0.05)}, tool, 0.5);
+  EXPECT_FALSE(straight.force_falls_at_m);
+  EXPECT_FALSE(straight.turns_sideways_at_m);
+  // Given unsorted: turns sideways at 3 mm (0.04 / 0.05 = 0.8 > 0.5), falls at 4 mm.
+  const BucklingOnset buckled = buckling_onset(
+      {at(0.004, 0.06, 0.045), at(0.001, 0.0, 0.01), at(0.003, 0.04, 0.05), at(0.002, 0.0, 0.03)},
+      tool, 0.5);
+  ASSERT_TRUE(buckled.force_falls_at_m);
+  EXPECT_DOUBLE_EQ(*buckled.force_falls_at_m, 0.004);
+  ASSERT_TRUE(buckled.turns_sideways_at_m);
+  EXPECT_DOUBLE_EQ(*buckled.turns_sideways_at_m, 0.003);
+  EXPECT_NEAR(buckled.lateral_fraction, 0.8, 1e-12);
+  // Equal forces at two depths: the force stopped growing there.
+  EXPECT_DOUBLE_EQ(
+      *buckling_onset({at(0.001, 0, 0.02), at(0.002, 0, 0.02)}, tool, 0.5).force_falls_at_m, 0.002);
+}
+
 TEST(InvertedTetrahedra, CountsAnElementTurnedInsideOutNotOneMerelySquashedOrMoved) {
   const BuiltVariant b = one_tetrahedron();
   Eigen::VectorXd x(12);

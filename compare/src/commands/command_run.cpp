@@ -31,6 +31,7 @@ int run_command(const Arguments& args) {
                            : std::optional<std::filesystem::path>(fem_cache_beside(final_dir));
   std::ostringstream printed;  // shown once the folder is in place
   std::vector<std::pair<std::string, std::string>> failed;
+  std::vector<std::string> buckled;  // "variant: warning", repeated on stderr
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
     RunSettings settings;
     settings.quiet = opt.flag("quiet");
@@ -39,6 +40,10 @@ int run_command(const Arguments& args) {
     settings.fem_cache_directory = cache;
     const CaseRun run = run_case(parameters, settings);
     failed = run.failed_variants;
+    for (const auto& v : run.variants)
+      for (const auto& w : v.warnings)
+        if (w.find(buckling_warning_start) != std::string::npos)
+          buckled.push_back(v.name + ": " + w);
     write_run_outputs(run, work_dir);
     if (opt.flag("json")) {
       printed << summary_json(run).dump(2) << '\n';
@@ -50,6 +55,8 @@ int run_command(const Arguments& args) {
     }
   });
   std::cout << printed.str();
+  for (const auto& warning : buckled)
+    std::cerr << "msfem run: warning: " << warning << "\n";
   for (const auto& [name, why] : failed)
     std::cerr << "msfem run: variant " << name << " failed: " << why << "\n";
   return failed.empty() ? 0 : 1;  // the others' results are written; scripts still see it

@@ -52,13 +52,35 @@ std::string millimetres(double metres) {
   return text;
 }
 
-// Why a variant's force falls with depth, with the evidence where the variant has volume elements:
-// edge springs keep a tetrahedron's edge lengths but not its orientation, so one turned inside out
-// costs nothing more than its mirror image and the network gives way under the tool.
-std::string force_falls_warning(const std::vector<ForceDepthPoint>& curve, Eigen::Index elements) {
-  std::string why =
-      "the reaction force does not grow with depth along the loading path: the network buckles or "
-      "snaps under the tool";
+double lateral_fraction(const Eigen::Vector3d& force, const Eigen::Vector3d& outward) {
+  const double axial = force.dot(outward);
+  return axial > 0 ? (force - axial * outward).norm() / axial : 0.0;
+}
+
+// Where and how a variant gives way under the tool, with the evidence where the variant has volume
+// elements: edge springs keep a tetrahedron's edge lengths but not its orientation, so one turned
+// inside out costs nothing more than its mirror image and the network gives way under the tool.
+// None when it does not. The FEM's lateral reaction at full depth sets how sideways is too far.
+std::optional<std::string> buckling_warning(const std::vector<ForceDepthPoint>& curve,
+                                            const ToolPlacement& tool, const FemSolution& fem,
+                                            Eigen::Index elements) {
+  const double fem_fraction = lateral_fraction(fem.tool_force, tool.outward_normal);
+  const double allowed = std::max(0.5, fem_fraction + lateral_fraction_margin);
+  const BucklingOnset onset = buckling_onset(curve, tool, allowed);
+  if (!onset.force_falls_at_m && !onset.turns_sideways_at_m) return std::nullopt;
+  std::string why = std::string(buckling_warning_start) + ":";
+  if (onset.force_falls_at_m)
+    why += " from " + millimetres(*onset.force_falls_at_m) + " of " + millimetres(tool.depth) +
+           " the reaction force stops growing with depth;";
+  if (onset.turns_sideways_at_m) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  " from %s the equilibrium turns sideways (lateral reaction %.2f of the axial, "
+                  "above %.2f; the FEM's is %.2f);",
+                  millimetres(*onset.turns_sideways_at_m).c_str(), onset.lateral_fraction, allowed,
+                  fem_fraction);
+    why += text;
+  }
   const auto first_inverted = std::find_if(curve.begin(), curve.end(), [](const auto& pt) {
     return pt.inverted_elements.value_or(0) > 0;
   });
@@ -67,15 +89,17 @@ std::string force_falls_warning(const std::vector<ForceDepthPoint>& curve, Eigen
         std::max_element(curve.begin(), curve.end(), [](const auto& a, const auto& b) {
           return a.inverted_elements.value_or(0) < b.inverted_elements.value_or(0);
         });
-    why += " (" + std::to_string(*first_inverted->inverted_elements) + " of " +
+    why += " " + std::to_string(*first_inverted->inverted_elements) + " of " +
            std::to_string(elements) + " tetrahedra are inverted at " +
-           millimetres(first_inverted->depth_m) + ", " + std::to_string(*worst->inverted_elements) +
-           " at " + millimetres(worst->depth_m) +
-           ": edge springs do not resist a tetrahedron turning inside out)";
+           millimetres(first_inverted->depth_m) +
+           (worst == first_inverted ? ""
+                                    : ", " + std::to_string(*worst->inverted_elements) + " at " +
+                                          millimetres(worst->depth_m)) +
+           " (edge springs do not resist a tetrahedron turning inside out);";
   } else {
-    why += " (a spring network has no resistance to inverted elements)";
+    why += " a spring network has no resistance to buckling or inverted elements;";
   }
-  return why + ", so its force-depth curve is not one a haptic device should render";
+  return why + " its force-depth curve is not one a haptic device should render";
 }
 
 // The surface vertices that neither a support nor the tool prescribes: the ones compared.
@@ -307,8 +331,9 @@ VariantResult run_variant(CaseRun& run, BuiltVariant& built, const std::vector<d
   const StaticSolution s = press(built, tool, path, curve);
   static_cast<ToolLoadVariant&>(r) =
       compare_at_tool(problem, built, s, std::move(curve), run.fem, run.compared_vertices, tool);
-  if (r.force_depth_monotone == false)
-    r.warnings.push_back(force_falls_warning(r.force_depth, built.tetrahedra.rows()));
+  if (tool)
+    if (auto warning = buckling_warning(r.force_depth, *tool, run.fem, built.tetrahedra.rows()))
+      r.warnings.push_back(*warning);
   std::string unresolved;
   for (const std::string& metric : unresolved_metrics(run, r))
     unresolved += (unresolved.empty() ? "" : ", ") + metric;
@@ -323,10 +348,9 @@ VariantResult run_variant(CaseRun& run, BuiltVariant& built, const std::vector<d
   if (settings.time_dynamics) r.timing = time_variant(built, problem.parameters.timing, s.x);
   press_other_tools(run, built, path);
   for (const ToolLoad& load : run.other_tools)
-    if (load.variants.back().force_depth_monotone == false)
-      r.warnings.push_back(
-          "tool " + std::to_string(load.tool) + ": " +
-          force_falls_warning(load.variants.back().force_depth, built.tetrahedra.rows()));
+    if (auto warning = buckling_warning(load.variants.back().force_depth, problem.tools[load.tool],
+                                        load.fem, built.tetrahedra.rows()))
+      r.warnings.push_back("at tool " + std::to_string(load.tool) + ": " + *warning);
   return r;
 }
 
@@ -379,6 +403,25 @@ std::optional<double> force_depth_exponent(const std::vector<ForceDepthPoint>& c
   const double spread = n * sxx - sx * sx;
   if (!(spread > 0.0)) return std::nullopt;
   return (n * sxy - sx * sy) / spread;
+}
+
+BucklingOnset buckling_onset(std::vector<ForceDepthPoint> curve, const ToolPlacement& tool,
+                             double max_lateral_fraction) {
+  std::sort(curve.begin(), curve.end(),
+            [](const auto& a, const auto& b) { return a.depth_m < b.depth_m; });
+  BucklingOnset onset;
+  for (std::size_t i = 0; i < curve.size(); ++i) {
+    const Eigen::Vector3d& f = curve[i].force_n;
+    if (i > 0 && !onset.force_falls_at_m &&
+        !(f.dot(tool.outward_normal) > curve[i - 1].force_n.dot(tool.outward_normal)))
+      onset.force_falls_at_m = curve[i].depth_m;
+    const double fraction = lateral_fraction(f, tool.outward_normal);
+    if (!onset.turns_sideways_at_m && fraction > max_lateral_fraction) {
+      onset.turns_sideways_at_m = curve[i].depth_m;
+      onset.lateral_fraction = fraction;
+    }
+  }
+  return onset;
 }
 
 std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,

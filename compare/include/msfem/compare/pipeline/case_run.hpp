@@ -141,4 +141,21 @@ std::optional<double> force_depth_exponent(const std::vector<ForceDepthPoint>& c
 std::optional<bool> force_grows_with_depth(std::vector<ForceDepthPoint> curve,
                                            const std::optional<ToolPlacement>& tool);
 
+/// Where a variant's equilibrium gives way under the tool along its loading path: the first depth
+/// at which the force along the tool's outward normal stops growing, and the first at which the
+/// lateral reaction exceeds `max_lateral_fraction` of the axial one.
+struct BucklingOnset {
+  std::optional<double> force_falls_at_m;
+  std::optional<double> turns_sideways_at_m;
+  double lateral_fraction = 0.0;  ///< lateral / axial where it turned sideways
+};
+BucklingOnset buckling_onset(std::vector<ForceDepthPoint> curve, const ToolPlacement& tool,
+                             double max_lateral_fraction);
+
+/// A variant's lateral reaction may exceed the FEM's own (the surface under the tool need not be
+/// flat) by this much of the axial force before the equilibrium counts as turned sideways.
+inline constexpr double lateral_fraction_margin = 0.25;
+/// Every buckling warning starts so (msfem run repeats them on stderr).
+inline constexpr const char* buckling_warning_start = "buckles under the tool";
+
 }  // namespace msfem::compare
