@@ -200,7 +200,9 @@ TEST(CaseSettings, EveryIntegratorIsTheOneTimed) {
     const Timing t = time_variant(v, timing, v.model->initial_state(), false);
     EXPECT_EQ(t.integrator, name_of(kind));
     EXPECT_GT(t.steps_per_second, 0.0);
-    if (kind == massspring::IntegratorKind::implicit_euler) EXPECT_EQ(t.stable_dt_s, 1e-3);
+    if (kind == massspring::IntegratorKind::implicit_euler) {
+      EXPECT_EQ(t.stable_dt_s, 1e-3);
+    }
   }
 }
 

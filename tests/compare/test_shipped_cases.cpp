@@ -50,8 +50,9 @@ TEST_P(ShippedCase, RunsWithItsReferencesOwnErrorBar) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // No variant gives way under the sphere cases' tool (a buckling warning is on stderr); on the
   // brain's folded cortex some do, and say so.
-  if (name.rfind("sphere", 0) == 0)
+  if (name.rfind("sphere", 0) == 0) {
     EXPECT_EQ(r.err.find("buckles under the tool"), std::string::npos) << r.err;
+  }
   const nlohmann::json s = nlohmann::json::parse(read_text(out / "summary.json"));
   const auto& fem = s.at("fem");
   ASSERT_TRUE(fem.at("estimated_rel_l2_error").is_number()) << fem.at("error_estimate").dump();
