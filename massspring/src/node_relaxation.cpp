@@ -41,9 +41,10 @@ NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
   left_to_newton_.assign(net.num_nodes(), 0);
   for (const auto& f : model.fields()) {
     const auto* nodal = dynamic_cast<const SphereContactForceField*>(f.field.get());
-    if (nodal && !nodal_contact_) nodal_contact_ = nodal;
+    const bool relaxed_here = nodal && !nodal_contact_;  // the first node contact only
+    if (relaxed_here) nodal_contact_ = nodal;
     for (int i : f.field->nodes())
-      (nodal == nodal_contact_ && nodal ? in_contact_set_ : left_to_newton_)[i] = 1;
+      (relaxed_here ? in_contact_set_ : left_to_newton_)[i] = 1;
   }
 }
 

@@ -99,17 +99,12 @@ VolumeForceField::VolumeForceField(int num_nodes, VolumeElements elements)
         throw ModelError("volume tetrahedron " + std::to_string(t) + " names node " +
                          std::to_string(elements_.tets(t, i)) + " of " +
                          std::to_string(num_nodes_));
-}
-
-std::vector<int> VolumeForceField::nodes() const {
   std::vector<char> in(num_nodes_, 0);
   for (Eigen::Index t = 0; t < elements_.tets.rows(); ++t)
     for (int k = 0; k < 4; ++k)
       in[elements_.tets(t, k)] = 1;
-  std::vector<int> list;
   for (int i = 0; i < num_nodes_; ++i)
-    if (in[i]) list.push_back(i);
-  return list;
+    if (in[i]) nodes_.push_back(i);
 }
 
 std::shared_ptr<const ForceField> VolumeForceField::scaled(const std::string& group,

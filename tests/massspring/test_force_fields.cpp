@@ -25,7 +25,11 @@ using testing::perturbed;
 // dashpot is what a field-blind ∂f/∂v would miss.
 class RestTether : public ForceField {
  public:
-  RestTether(Eigen::VectorXd rest, double k, double c) : rest_(std::move(rest)), k_(k), c_(c) {}
+  RestTether(Eigen::VectorXd rest, double k, double c)
+      : rest_(std::move(rest)), k_(k), c_(c), nodes_(rest_.size() / 3) {
+    for (std::size_t i = 0; i < nodes_.size(); ++i)
+      nodes_[i] = static_cast<int>(i);
+  }
   int num_dofs() const override { return static_cast<int>(rest_.size()); }
   void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                  Eigen::VectorXd& f) const override {
@@ -51,12 +55,7 @@ class RestTether : public ForceField {
     for (int i = 0; i < num_dofs(); ++i)
       t.emplace_back(i, i, -c_);
   }
-  std::vector<int> nodes() const override {
-    std::vector<int> all(num_dofs() / 3);
-    for (int i = 0; i < num_dofs() / 3; ++i)
-      all[i] = i;
-    return all;
-  }
+  const std::vector<int>& nodes() const override { return nodes_; }
   std::vector<std::string> coefficient_groups() const override { return {"tether"}; }
   std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const override {
     if (group != "tether") return ForceField::scaled(group, factor);
@@ -66,6 +65,7 @@ class RestTether : public ForceField {
  private:
   Eigen::VectorXd rest_;
   double k_, c_;
+  std::vector<int> nodes_;
 };
 
 MassSpringModel three_tier_model() {

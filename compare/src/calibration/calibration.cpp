@@ -254,8 +254,7 @@ class GroupFit {
     for (int g = 0; g < n_; ++g)
       weights[g + 1] = std::exp(theta[g]);
     for (const auto& field : base_.model->fields())
-      weights.push_back(field.name == ms::MassSpringModel::volume_field ? volume_factor_at(theta)
-                                                                        : 1.0);
+      weights.push_back(names_volume_group(*field.field) ? volume_factor_at(theta) : 1.0);
     std::vector<LoadErrors> errors;
     for (std::size_t i = 0; i < references.size(); ++i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
@@ -312,10 +311,14 @@ class GroupFit {
   std::vector<ms::MassSpringModel::NamedField> fields_at(const std::vector<double>& theta) const {
     std::vector<ms::MassSpringModel::NamedField> scaled;
     for (const auto& f : base_.model->fields())
-      for (const std::string& group : f.field->coefficient_groups())
-        if (group == volume_group && volume_index_ >= 0)
-          scaled.push_back({f.name, f.field->scaled(group, volume_factor_at(theta))});
+      if (names_volume_group(*f.field) && volume_index_ >= 0)
+        scaled.push_back({f.name, f.field->scaled(volume_group, volume_factor_at(theta))});
     return scaled;
+  }
+
+  static bool names_volume_group(const ms::ForceField& field) {
+    const std::vector<std::string> groups = field.coefficient_groups();
+    return std::find(groups.begin(), groups.end(), volume_group) != groups.end();
   }
 
   double volume_factor_at(const std::vector<double>& theta) const {

@@ -67,7 +67,7 @@ class ForceField : public ForceModel {
  public:
   /// The nodes whose forces this field sets (the static solver's node relaxation leaves them to
   /// Newton, unless it knows the field).
-  virtual std::vector<int> nodes() const = 0;
+  virtual const std::vector<int>& nodes() const = 0;
   /// Names of the coefficient groups a fit may scale, each one factor on a set of stiffnesses
   /// (volume preservation: "volume"); none by default.
   virtual std::vector<std::string> coefficient_groups() const { return {}; }

@@ -37,7 +37,7 @@ class SurfaceContactForceField : public ToolContact {
                          Linearisation mode = Linearisation::exact) const override;
 
   const SphereTool& tool() const override { return tool_; }
-  std::vector<int> nodes() const override { return nodes_; }
+  const std::vector<int>& nodes() const override { return nodes_; }
   double penalty_stiffness() const override { return pressure_penalty_ * mean_node_area_; }
   double pressure_penalty() const { return pressure_penalty_; }
   /// κ (Pa/m), finite and > 0 (ModelError otherwise).

@@ -63,7 +63,7 @@ class SphereContactForceField : public ToolContact {
                          Linearisation mode = Linearisation::exact) const override;
 
   const SphereTool& tool() const override { return tool_; }
-  std::vector<int> nodes() const override { return nodes_; }
+  const std::vector<int>& nodes() const override { return nodes_; }
   double penalty_stiffness() const override { return penalty_; }
 
  private:

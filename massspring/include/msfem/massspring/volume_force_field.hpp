@@ -48,7 +48,7 @@ class VolumeForceField : public ForceField {
   void add_dfdv_triplets(const Eigen::VectorXd&, Triplets&) const override {}
 
   /// The nodes of its elements.
-  std::vector<int> nodes() const override;
+  const std::vector<int>& nodes() const override { return nodes_; }
   /// "volume": every element's modulus.
   std::vector<std::string> coefficient_groups() const override { return {"volume"}; }
   std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const override;
@@ -62,6 +62,7 @@ class VolumeForceField : public ForceField {
  private:
   int num_nodes_;
   VolumeElements elements_;
+  std::vector<int> nodes_;  ///< of its elements, ascending
 };
 
 /// The prisms between a triangle mesh's tiers: for every triangle (a, b, c) of `triangles` and
