@@ -28,12 +28,12 @@ cases::CaseParameters sphere_case() {
 }
 
 // "FEM" data: the three-tier model with the given group scales, solved on each tool at its depth.
-std::vector<LoadReference> synthetic_references(const Problem& truth, std::vector<double> depths = {
+std::vector<CalibrationLoad> synthetic_references(const Problem& truth, std::vector<double> depths = {
                                                                           0.004, 0.003, 0.0035}) {
-  std::vector<LoadReference> refs;
+  std::vector<CalibrationLoad> refs;
   const fem_reference::VolumeMesh no_mesh;
   for (std::size_t i = 0; i < truth.tools.size(); ++i) {
-    LoadReference r;
+    CalibrationLoad r;
     r.load = {truth.parameters.loads.tool.directions[i], depths[i]};
     r.tool = at_depth(truth.tools[i], depths[i]);
     BuiltVariant v = build_variant(cases::Variant::three_tier, truth, no_mesh, r.tool);
@@ -59,15 +59,15 @@ CalibrationFit expect_recovers(const cases::CaseParameters& p,
   cases::CaseParameters with_truth = p;
   for (std::size_t g = 0; g < groups.size(); ++g)
     with_truth.mass_spring.group_scales.emplace_back(groups[g], truth[g]);
-  const std::vector<LoadReference> refs = synthetic_references(make_problem(with_truth));
+  const std::vector<CalibrationLoad> refs = synthetic_references(make_problem(with_truth));
   CalibrationOptions options;
   options.groups = groups;
   options.tolerance = 1e-7;
   options.max_evaluations = 2000;
   for (std::size_t g = 0; g < groups.size(); ++g)
     options.start_factors.push_back(truth[g] * start_off[g]);
-  const std::vector<LoadReference> train(refs.begin(), refs.begin() + 2);
-  const std::vector<LoadReference> test(refs.begin() + 2, refs.end());
+  const std::vector<CalibrationLoad> train(refs.begin(), refs.begin() + 2);
+  const std::vector<CalibrationLoad> test(refs.begin() + 2, refs.end());
   const CalibrationFit fit =
       calibrate(make_problem(p), {}, cases::Variant::three_tier, train, test, options);
   EXPECT_EQ(fit.groups.size(), groups.size());
@@ -167,7 +167,7 @@ void expect_linear_agrees_and_recovers(cases::CaseParameters p,
   p.loads.tool.depth_m = 0.00005;
   p.loads.tool.directions = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
   p.mass_spring.group_scales = truth;
-  const std::vector<LoadReference> refs = synthetic_references(make_problem(p), {5e-5, 5e-5});
+  const std::vector<CalibrationLoad> refs = synthetic_references(make_problem(p), {5e-5, 5e-5});
   p.mass_spring.group_scales.clear();
   const Problem problem = make_problem(p);
   CalibrationOptions options;

@@ -455,5 +455,43 @@ TEST(RunOptions, NoCurveGivesTheSameEquilibrium) {
   }
 }
 
+// The reference is cached per load: a run that changes one load's reference (--no-curve drops the
+// first load's force-depth curve) solves that load again and reads the other from the cache, with
+// the very numbers it had; the same run again reads every load from the cache.
+TEST(RunOptions, EachLoadsReferenceIsCachedOnItsOwn) {
+  TemporaryDirectory dir;
+  const std::string common = "run " + small_case + " --quiet --no-timing" +
+                             " --set \"loads/tool/directions=0,0,1; 1,0,0\"" +
+                             " --set \"mass spring/variants=three_tier\" --out ";
+  const auto first = run_msfem(common + (dir / "first").string());
+  const auto lean = run_msfem(common + (dir / "lean").string() + " --no-curve");
+  const auto again = run_msfem(common + (dir / "again").string());
+  for (const auto* r : {&first, &lean, &again})
+    ASSERT_EQ(r->exit_code, 0) << r->err;
+  const auto a = nlohmann::json::parse(read_text(dir / "first" / "summary.json"));
+  const auto b = nlohmann::json::parse(read_text(dir / "lean" / "summary.json"));
+  const auto c = nlohmann::json::parse(read_text(dir / "again" / "summary.json"));
+  ASSERT_EQ(a["fem"]["loads"].size(), 2u);
+  EXPECT_FALSE(a["fem"]["loads"][0]["from_cache"]);
+  EXPECT_FALSE(a["fem"]["loads"][1]["from_cache"]);
+  EXPECT_FALSE(b["fem"]["loads"][0]["from_cache"]);
+  EXPECT_TRUE(b["fem"]["loads"][1]["from_cache"]);
+  EXPECT_FALSE(b["fem"]["from_cache"]);
+  EXPECT_TRUE(c["fem"]["from_cache"]);
+  EXPECT_EQ(c["fem"]["cache_key"], a["fem"]["cache_key"]);
+  EXPECT_NE(b["fem"]["cache_key"], a["fem"]["cache_key"]);
+  for (const auto* other : {&b, &c}) {
+    EXPECT_EQ((*other)["fem"]["loads"][1]["reaction_force_N"],
+              a["fem"]["loads"][1]["reaction_force_N"]);
+    EXPECT_EQ((*other)["fem"]["loads"][0]["reaction_force_N"],
+              a["fem"]["loads"][0]["reaction_force_N"]);
+    const auto& tools = (*other)["variants"][0]["loads"]["per_tool"];
+    for (std::size_t t = 0; t < 2; ++t)
+      EXPECT_DOUBLE_EQ(tools[t]["rel_l2_error"].get<double>(),
+                       a["variants"][0]["loads"]["per_tool"][t]["rel_l2_error"].get<double>())
+          << "tool " << t;
+  }
+}
+
 }  // namespace
 }  // namespace msfem

@@ -82,7 +82,7 @@ int nodes_in_contact(const BuiltVariant& variant, const Eigen::VectorXd& x) {
   return count;
 }
 
-LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d& displacement,
+LoadErrors errors_against(const CalibrationLoad& reference, const Eigen::MatrixX3d& displacement,
                           const Eigen::Vector3d& force, const BuiltVariant& variant,
                           const Eigen::VectorXd& x = {}) {
   LoadErrors e;
@@ -103,7 +103,7 @@ LoadErrors errors_against(const LoadReference& reference, const Eigen::MatrixX3d
   return e;
 }
 
-LoadModels models_for(const BuiltVariant& base, const std::vector<LoadReference>& references) {
+LoadModels models_for(const BuiltVariant& base, const std::vector<CalibrationLoad>& references) {
   LoadModels m;
   for (const auto& r : references) {
     BuiltVariant v;
@@ -122,31 +122,23 @@ LoadModels models_for(const BuiltVariant& base, const std::vector<LoadReference>
 // unique (the shell can turn under an oblique load, or slide off a tool placed at full depth at
 // once): it is pressed from rest along quarters of its depth (finer with the case's path step),
 // each from the last. A bonded patch is solved from rest at its depth.
-StaticSolution equilibrium_from_rest(BuiltVariant& variant, const LoadReference& reference,
+StaticSolution equilibrium_from_rest(BuiltVariant& variant, const CalibrationLoad& reference,
                                      double path_step) {
-  if (!variant.model->contact()) {
-    set_tool_depth(variant, reference.tool);
-    return solve_variant_static(variant);
-  }
   const double d = reference.tool.depth;
-  StaticSolution s;
-  for (double depth : loading_path({0.25 * d, 0.5 * d, 0.75 * d}, d, path_step)) {
-    set_tool_depth(variant, at_depth(reference.tool, depth));
-    s = solve_variant_static(variant, s.x);
-  }
-  set_tool_depth(variant, reference.tool);
-  return s;
+  return press(variant, reference.tool,
+               variant.model->contact() ? loading_path({0.25 * d, 0.5 * d, 0.75 * d}, d, path_step)
+                                        : std::vector<double>{d});
 }
 
 // The load's equilibrium from `x`, or from rest as msfem run reaches it when `x` is empty.
-StaticSolution equilibrium(BuiltVariant& variant, const LoadReference& reference,
+StaticSolution equilibrium(BuiltVariant& variant, const CalibrationLoad& reference,
                            const Eigen::VectorXd& x, double path_step) {
   if (x.size() == 0) return equilibrium_from_rest(variant, reference, path_step);
   set_tool_depth(variant, reference.tool);
   return solve_variant_static(variant, x);
 }
 
-std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<LoadReference>& references,
+std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<CalibrationLoad>& references,
                                      const Eigen::VectorXd& stiffness,
                                      const std::vector<ms::MassSpringModel::NamedField>& fields,
                                      double path_step) {
@@ -228,7 +220,7 @@ class GroupFit {
 
   int size() const { return n_; }
 
-  LoadModels models_on(const std::vector<LoadReference>& references) const {
+  LoadModels models_on(const std::vector<CalibrationLoad>& references) const {
     LoadModels m = models_for(base_, references);
     if (!options_.linear) return m;
     // Part 0: the springs not fitted (weight 1); part g + 1: fitted group g (weight exp θ_g).
@@ -243,7 +235,7 @@ class GroupFit {
     return m;
   }
 
-  std::vector<LoadErrors> evaluate(LoadModels& m, const std::vector<LoadReference>& references,
+  std::vector<LoadErrors> evaluate(LoadModels& m, const std::vector<CalibrationLoad>& references,
                                    const std::vector<double>& theta) const {
     if (!options_.linear)
       return evaluate_all(m, references, stiffness_at(theta), fields_at(theta),
@@ -390,14 +382,14 @@ void optimise(const std::function<double(const std::vector<double>&)>& j, BestPo
 
 }  // namespace
 
-LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x,
-                         double path_step) {
+LoadErrors evaluate_load(BuiltVariant& variant, const CalibrationLoad& reference,
+                         Eigen::VectorXd& x, double path_step) {
   const StaticSolution s = equilibrium(variant, reference, x, path_step);
   x = s.x;
   return errors_against(reference, s.surface_displacement, s.tool_force, variant, s.x);
 }
 
-LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference) {
+LoadErrors evaluate_load_linear(BuiltVariant& variant, const CalibrationLoad& reference) {
   set_tool_depth(variant, reference.tool);
   ms::LinearisedStatics statics(*variant.model, {variant.model->network().stiffness},
                                 cholmod_factorization());
@@ -406,8 +398,8 @@ LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& refe
 }
 
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                         cases::Variant variant, const std::vector<LoadReference>& train,
-                         const std::vector<LoadReference>& test,
+                         cases::Variant variant, const std::vector<CalibrationLoad>& train,
+                         const std::vector<CalibrationLoad>& test,
                          const CalibrationOptions& options) {
   const auto start = Clock::now();
   const std::string& file = problem.parameters.file.string();

@@ -8,18 +8,12 @@
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
-#include "msfem/compare/pipeline/content_hash.hpp"
-#include "msfem/compare/pipeline/fem_cache.hpp"
+#include "msfem/compare/pipeline/fem_references.hpp"
 #include "msfem/compare/pipeline/fem_run.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 cases::Variant resolve_variant(const cases::CaseParameters& p, const CalibrationRequest& request) {
   const cases::Variant variant =
@@ -99,45 +93,6 @@ ToolPlacement placement_of(const Problem& problem, const cases::ToolLoad& load) 
   throw std::logic_error("calibration: no tool placed for load " + load.label());
 }
 
-std::string load_key(const std::string& problem_key, const cases::ToolLoad& load) {
-  ContentHash h;
-  h.text("msfem-calibration-load-1").text(problem_key).matrix(load.direction).number(load.depth_m);
-  return h.hex();
-}
-
-// The reference's own error at the freshly solved loads (as many as fem/error estimate's plan
-// allows), then each fresh load stored in the cache with its estimate.
-void estimate_and_store(CaseCalibration& c, std::vector<LoadReference>& references,
-                        const std::vector<std::optional<FemCacheEntry>>& cached,
-                        const std::vector<FemSolution>& solved, const ErrorEstimatePlan& plan,
-                        const std::string& problem_key, const CalibrationRequest& request,
-                        const Progress& progress) {
-  std::vector<std::size_t> fresh;
-  std::vector<const FemSolution*> solutions;
-  std::vector<std::vector<int>> compared;
-  std::vector<std::optional<ToolPlacement>> tools;
-  for (std::size_t i = 0; i < references.size(); ++i)
-    if (!cached[i]) {
-      fresh.push_back(i);
-      solutions.push_back(&solved[solutions.size()]);
-      compared.push_back(references[i].compared_vertices);
-      tools.emplace_back(references[i].tool);
-    }
-  if (plan.method != cases::FemParameters::ErrorEstimate::none && !fresh.empty())
-    progress.stage("estimating the reference's own error (" + plan.note + ")");
-  const FemErrorEstimate estimate =
-      estimate_fem_error(c.problem, c.mesh, plan, solutions, compared, tools);
-  for (std::size_t k = 0; k < fresh.size(); ++k) {
-    LoadReference& r = references[fresh[k]];
-    r.fem_error = estimate.loads[k];
-    if (!request.fem_cache_directory) continue;
-    FemErrorEstimate one = estimate;
-    one.loads = {estimate.loads[k]};
-    store_fem_cache(*request.fem_cache_directory, load_key(problem_key, r.load),
-                    {c.mesh, solved[k], {}, {}, one});
-  }
-}
-
 // Two directions can pick the same surface vertex: a held-out load pressed where and as deep as a
 // training load is the same load, and would check the fit on what it was fitted to.
 void check_distinct_vertices(const Problem& problem, const std::vector<cases::ToolLoad>& train,
@@ -153,69 +108,41 @@ void check_distinct_vertices(const Problem& problem, const std::vector<cases::To
     }
 }
 
-// The FEM of every load, from the cache where it is there.
+// The FEM of every load through the pipeline's one cache, on one mesh refined at every tool.
 void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& train,
                       const std::vector<cases::ToolLoad>& test, const CalibrationRequest& request,
                       const Progress& progress) {
   const Problem& problem = c.problem;
-  const std::string problem_key = fem_cache_key(problem, {});
   std::vector<cases::ToolLoad> all = train;
   all.insert(all.end(), test.begin(), test.end());
-  std::vector<std::optional<FemCacheEntry>> cached(all.size());
-  bool have_mesh = false;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    if (request.fem_cache_directory)
-      cached[i] = load_fem_cache(*request.fem_cache_directory, load_key(problem_key, all[i]));
-    if (cached[i] && !have_mesh) {
-      c.mesh = cached[i]->mesh;  // every load shares one mesh, refined near every tool
-      have_mesh = true;
-    }
-  }
-  if (!have_mesh) {
-    progress.stage("meshing the volume (Gmsh), refined near all " +
-                   std::to_string(problem.tools.size()) + " tool positions");
-    c.mesh = mesh_problem(problem, problem.tools);
-  }
-  check_no_rigid_motion(problem, c.mesh, placement_of(problem, all.front()));
-  const int fresh = static_cast<int>(std::count(cached.begin(), cached.end(), std::nullopt));
-  // Decided (and refused, for a method that cannot run) before the first solve.
-  const ErrorEstimatePlan plan = plan_error_estimate(problem, c.mesh, fresh, fresh);
+  ReferenceRequest r;
+  for (const auto& load : all)
+    r.loads.emplace_back(placement_of(problem, load));
+  r.refine_near = problem.tools;
+  r.planned_solves = static_cast<int>(all.size());
+  r.cache_directory = request.fem_cache_directory;
   const auto start = Clock::now();
-  std::vector<FemSolution> solved;  // the fresh loads', in load order, for the estimate
-  std::vector<LoadReference> references;
+  FemReferences references = fem_references(problem, r, progress);
+  c.mesh = std::move(references.mesh);
+  c.fem_solves = references.solved;
+  c.fem_from_cache = references.from_cache;
   for (std::size_t i = 0; i < all.size(); ++i) {
-    LoadReference r;
-    r.load = all[i];
-    r.tool = placement_of(problem, all[i]);
-    const std::vector<bool> prescribed = prescribed_surface_vertices(problem, r.tool);
-    for (std::size_t v = 0; v < prescribed.size(); ++v)
-      if (!prescribed[v]) r.compared_vertices.push_back(static_cast<int>(v));
-    if (cached[i]) {
-      ++c.fem_from_cache;
-      r.surface_displacement = cached[i]->solution.surface_displacement;
-      r.tool_force = cached[i]->solution.tool_force;
-      if (!cached[i]->error_estimate.loads.empty())
-        r.fem_error = cached[i]->error_estimate.loads.front();
-    } else {
-      solved.push_back(solve_fem(problem, c.mesh, r.tool));
-      ++c.fem_solves;
-      r.surface_displacement = solved.back().surface_displacement;
-      r.tool_force = solved.back().tool_force;
-    }
-    references.push_back(std::move(r));
-    progress.advance("FEM reference per load (" + std::to_string(c.fem_from_cache) + " cached)",
-                     static_cast<int>(i + 1), static_cast<int>(all.size()), seconds_since(start));
+    LoadReference& fem = references.loads[i];
+    CalibrationLoad load{all[i],
+                         *fem.tool,
+                         std::move(fem.fem.surface_displacement),
+                         fem.fem.tool_force,
+                         std::move(fem.compared_vertices),
+                         fem.fem_error};
+    (i < train.size() ? c.train : c.test).push_back(std::move(load));
   }
-  estimate_and_store(c, references, cached, solved, plan, problem_key, request, progress);
-  for (std::size_t i = 0; i < references.size(); ++i)
-    (i < train.size() ? c.train : c.test).push_back(std::move(references[i]));
   c.fem_time_s = seconds_since(start);
 }
 
 // Fitted errors within 3x of the reference's own at their load: the fit cannot be judged there.
 void note_unresolved_loads(CaseCalibration& c) {
   std::string list;
-  auto check = [&](const std::vector<LoadReference>& references,
+  auto check = [&](const std::vector<CalibrationLoad>& references,
                    const std::vector<LoadErrors>& errors) {
     for (std::size_t i = 0; i < references.size() && i < errors.size(); ++i) {
       const LoadErrorEstimate& e = references[i].fem_error;

@@ -32,7 +32,7 @@ nlohmann::json estimates_json(const CaseCalibration& c) {
   for (const auto& [side, references] :
        {std::pair{"train", &c.train}, std::pair{"test", &c.test}}) {
     nlohmann::json list = nlohmann::json::array();
-    for (const LoadReference& r : *references)
+    for (const CalibrationLoad& r : *references)
       list.push_back({{"load", r.load.label()},
                       {"estimated_rel_l2_error", json_or_null(r.fem_error.rel_l2_error)},
                       {"estimated_force_rel_error", json_or_null(r.fem_error.force_rel_error)}});

@@ -49,8 +49,9 @@ int run_command(const Arguments& args) {
       printed << summary_json(run).dump(2) << '\n';
     } else {
       printed << "case " << parameters.name << ": " << run.problem.surface.num_vertices()
-              << " surface vertices, FEM " << run.fem.statistics.dofs << " dofs ("
-              << run.fem.statistics.cells << " cells), run took " << run.wall_time_s << " s\n"
+              << " surface vertices, FEM " << run.loads.front().fem.statistics.dofs << " dofs ("
+              << run.loads.front().fem.statistics.cells << " cells), run took " << run.wall_time_s
+              << " s\n"
               << variant_table(run) << "results in " << final_dir.string() << "\n";
     }
   });

@@ -15,11 +15,6 @@
 namespace msfem::compare {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
 nlohmann::json variant_parameters(const massspring::MassSpringModel& model) {
   const auto& n = model.network();
   nlohmann::json groups = nlohmann::json::object();
@@ -102,19 +97,6 @@ std::optional<std::string> buckling_warning(const std::vector<ForceDepthPoint>& 
   return why + " its force-depth curve is not one a haptic device should render";
 }
 
-// The surface vertices that neither a support nor the tool prescribes: the ones compared.
-std::vector<int> unprescribed_vertices(const Problem& problem,
-                                       const std::optional<ToolPlacement>& tool) {
-  std::vector<int> free;
-  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
-  for (std::size_t v = 0; v < prescribed.size(); ++v)
-    if (!prescribed[v]) free.push_back(static_cast<int>(v));
-  if (free.empty())
-    throw cases::InputError(problem.parameters.file.string() +
-                            ": every surface vertex is prescribed");
-  return free;
-}
-
 // How many solves the case's reference takes as `msfem run` makes it: each tool position, and the
 // force-depth curve's depths other than the case's. Independent of what one command skips, so
 // that the error estimate's method (and the cache entry) is the same for every command.
@@ -127,78 +109,45 @@ int reference_solve_count(const Problem& problem) {
                                         [&](double d) { return d != tool.depth_m; }));
 }
 
-std::vector<ForceDepthPoint> fem_force_depth(const Problem& problem,
-                                             const fem_reference::VolumeMesh& mesh,
-                                             const FemSolution& at_depth_solution,
-                                             const std::optional<ToolPlacement>& tool,
-                                             const std::vector<double>& depths,
-                                             const Progress& progress) {
-  std::vector<ForceDepthPoint> curve;
-  const auto start = Clock::now();
-  for (std::size_t i = 0; i < depths.size(); ++i) {
-    // The run's own depth is already solved.
-    const FemSolution s = depths[i] == tool->depth
-                              ? at_depth_solution
-                              : solve_fem(problem, mesh, at_depth(*tool, depths[i]));
-    curve.push_back({depths[i], s.tool_force, std::nullopt, s.contact});
-    progress.advance("FEM force-depth curve", static_cast<int>(i + 1),
-                     static_cast<int>(depths.size()), seconds_since(start));
-  }
-  return curve;
+// The FEM at every load of the run (each tool position of the case, or the one load without a
+// tool), on one mesh refined at each tool it presses with.
+void reference_at_every_load(CaseRun& run, const RunSettings& settings, const Progress& progress) {
+  const Problem& problem = run.problem;
+  ReferenceRequest request;
+  request.loads = {problem.tools.empty() ? std::nullopt
+                                         : std::optional<ToolPlacement>(problem.tools.front())};
+  if (settings.all_tools)
+    for (std::size_t t = 1; t < problem.tools.size(); ++t)
+      request.loads.emplace_back(problem.tools[t]);
+  for (const auto& t : request.loads)
+    if (t) request.refine_near.push_back(*t);
+  const std::optional<ToolPlacement>& tool = request.loads.front();
+  if (tool && settings.force_depth_curve)
+    request.curve_depths = curve_depths(problem.parameters.loads.tool);
+  request.planned_solves = reference_solve_count(problem);
+  request.cache_directory = settings.fem_cache_directory;
+  FemReferences references = fem_references(problem, request, progress);
+  run.mesh = std::move(references.mesh);
+  run.loads = std::move(references.loads);
+  run.fem_error = std::move(references.estimate);
+  run.worst_cell_quality = references.worst_cell_quality;
+  run.fem_from_cache = references.solved == 0;
+  run.fem_force_depth_monotone = force_grows_with_depth(run.loads.front().force_depth, tool);
 }
 
-FemErrorEstimate estimate_run_error(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                                    const ErrorEstimatePlan& plan, const FemSolution& first,
-                                    const std::vector<FemSolution>& others) {
-  std::vector<const FemSolution*> references = {&first};
-  std::vector<std::optional<ToolPlacement>> tools = {
-      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front())};
-  for (std::size_t t = 0; t < others.size(); ++t) {
-    references.push_back(&others[t]);
-    tools.emplace_back(problem.tools[t + 1]);
-  }
-  std::vector<std::vector<int>> compared;
-  for (const auto& tool : tools)
-    compared.push_back(unprescribed_vertices(problem, tool));
-  return estimate_fem_error(problem, mesh, plan, references, compared, tools);
-}
-
-// The variant's equilibrium with `tool` at its depth. With a path, a quasi-static loading path,
-// each depth started from the last, as a tool pressed in steps is: a network with several
-// equilibria (one that buckles under the tool) then stays on the branch a simulator would follow.
-// Every step is a point of `curve` (a fall between two curve depths must not go unseen). The path
-// ends at the tool's depth; the variant is left pressed there.
-StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& tool,
-                     const std::vector<double>& path, std::vector<ForceDepthPoint>& curve) {
-  if (!tool || path.empty()) {
-    if (tool) set_tool_depth(built, *tool);
-    return solve_variant_static(built);
-  }
-  StaticSolution s;
-  Eigen::VectorXd x;
-  for (double depth : path) {
-    set_tool_depth(built, at_depth(*tool, depth));
-    StaticSolution at = solve_variant_static(built, x);
-    x = at.x;
-    curve.push_back({depth, at.tool_force, inverted_tetrahedra(built, at.x), {}});
-    if (depth == tool->depth) s = std::move(at);
-  }
-  set_tool_depth(built, *tool);
-  return s;
-}
-
-// The variant's equilibrium `s` (reached along `curve`) against the FEM's at the same tool: the
-// same metrics for the run's own tool and for every other one.
-ToolLoadVariant compare_at_tool(const Problem& problem, const BuiltVariant& built,
+// The variant's equilibrium `s` (reached along `curve`) against the FEM's at the same load.
+ToolLoadVariant compare_at_load(const Problem& problem, const BuiltVariant& built,
                                 const StaticSolution& s, std::vector<ForceDepthPoint> curve,
-                                const FemSolution& fem, const std::vector<int>& compared,
-                                const std::optional<ToolPlacement>& tool) {
+                                const LoadReference& load) {
+  const FemSolution& fem = load.fem;
+  const std::optional<ToolPlacement>& tool = load.tool;
   ToolLoadVariant o;
   o.kind = built.kind;
   o.name = built.name;
-  o.errors = zoned_displacement_error(
-      s.surface_displacement, fem.surface_displacement, problem.surface.vertices, compared,
-      tool ? tool->contact_point : problem.centroid, tool ? 2 * tool->radius : 0.0);
+  o.errors = zoned_displacement_error(s.surface_displacement, fem.surface_displacement,
+                                      problem.surface.vertices, load.compared_vertices,
+                                      tool ? tool->contact_point : problem.centroid,
+                                      tool ? 2 * tool->radius : 0.0);
   o.tool_force = s.tool_force;
   if (tool) o.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, fem.tool_force);
   o.volume_change = volume_change(problem.surface, s.surface_displacement);
@@ -212,159 +161,112 @@ ToolLoadVariant compare_at_tool(const Problem& problem, const BuiltVariant& buil
     o.patch_displacement_rel_error =
         (*o.patch_mean_displacement - reference).norm() / reference.norm();
   }
+  o.newton_iterations = s.newton_iterations;
+  o.equilibrium = s.x;
+  o.surface_displacement = s.surface_displacement;
+  o.error = s.surface_displacement - fem.surface_displacement;
   return o;
 }
 
-// The variant at each of the case's other tool positions, along the same loading path. Two
-// workers (each with its own copy of the network) share the tools: the statics are independent
-// and a machine with two cores finishes the brain's four tools in about half the time. The
-// timing is over by now, so nothing measured runs beside them.
-void press_other_tools(CaseRun& run, BuiltVariant& built, const std::vector<double>& path) {
-  const int n = static_cast<int>(run.other_tools.size());
-  if (n == 0) return;
-  const Problem& problem = run.problem;
-  std::vector<ToolLoadVariant> results(n);
+// The variant pressed along the loading path at one load and measured there.
+ToolLoadVariant at_load(const Problem& problem, BuiltVariant& built, const LoadReference& load,
+                        const std::vector<double>& path) {
+  std::vector<ForceDepthPoint> curve;
+  const StaticSolution s = press(built, load.tool, path, &curve);
+  return compare_at_load(problem, built, s, std::move(curve), load);
+}
+
+// The variant at loads [first, end) of the run. Two workers (each with its own copy of the
+// network) share them: the statics are independent and a machine with two cores finishes the
+// brain's tools in about half the time. Nothing timed runs beside them.
+void press_loads(const CaseRun& run, BuiltVariant& built, const std::vector<double>& path,
+                 std::size_t first, std::vector<ToolLoadVariant>& results) {
+  const std::size_t n = run.loads.size();
+  if (first >= n) return;
+  results.resize(n);
   std::vector<std::exception_ptr> errors(n);
-  auto work = [&](BuiltVariant& variant, int first) {
-    for (int k = first; k < n; k += 2) {
+  auto work = [&](BuiltVariant& variant, std::size_t from, std::size_t stride) {
+    for (std::size_t k = from; k < n; k += stride) {
       try {
-        const ToolLoad& load = run.other_tools[k];
-        const ToolPlacement& other = problem.tools[load.tool];
-        std::vector<ForceDepthPoint> curve;
-        const StaticSolution at = press(variant, other, path, curve);
-        results[k] = compare_at_tool(problem, variant, at, std::move(curve), load.fem,
-                                     load.compared_vertices, other);
+        results[k] = at_load(run.problem, variant, run.loads[k], path);
       } catch (...) {
         errors[k] = std::current_exception();
       }
     }
   };
-  if (n == 1 || std::thread::hardware_concurrency() < 2) {
-    work(built, 0);
+  if (n - first == 1 || std::thread::hardware_concurrency() < 2) {
+    work(built, first, 1);
   } else {
-    const std::optional<ToolPlacement> first_tool = problem.tools.front();
-    BuiltVariant copy = build_variant(built.kind, problem, run.mesh, first_tool);
-    std::thread second([&] { work(copy, 1); });
-    work(built, 0);
+    BuiltVariant copy = build_variant(built.kind, run.problem, run.mesh, run.loads.front().tool);
+    std::thread second([&] { work(copy, first + 1, 2); });
+    work(built, first, 2);
     second.join();
   }
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
-  for (int k = 0; k < n; ++k)
-    run.other_tools[k].variants.push_back(std::move(results[k]));
 }
 
-// Solves (or reads from the cache) the FEM at every load of the run, its force-depth curve and its
-// own error estimate, and fills in each load's compared vertices.
-void reference_solutions(CaseRun& run, const RunSettings& settings,
-                         const std::vector<double>& depths, int other_tools,
-                         const Progress& progress) {
-  const Problem& problem = run.problem;
-  const std::optional<ToolPlacement> tool =
-      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
-  run.fem_cache_key = fem_cache_key(problem, depths, other_tools > 0);
-  std::optional<FemCacheEntry> cached;
-  if (settings.fem_cache_directory)
-    cached = load_fem_cache(*settings.fem_cache_directory, run.fem_cache_key);
-  if (cached && static_cast<int>(cached->other_tools.size()) != other_tools) cached.reset();
-  std::vector<FemSolution> other_fem;
-  if (cached) {
-    progress.stage("FEM reference from the cache (" +
-                   (*settings.fem_cache_directory / (run.fem_cache_key + ".cbor")).string() +
-                   "): nothing it depends on changed");
-    run.mesh = std::move(cached->mesh);
-    run.fem = std::move(cached->solution);
-    run.fem_force_depth = std::move(cached->force_depth);
-    other_fem = std::move(cached->other_tools);
-    run.fem_error = std::move(cached->error_estimate);
-    run.fem_from_cache = true;
-  } else {
-    progress.stage("meshing the volume (Gmsh) for the FEM reference");
-    // One mesh for every load, refined at each tool it presses with.
-    run.mesh = other_tools > 0 ? mesh_problem(problem, problem.tools) : mesh_problem(problem);
-    // Decided (and refused, for a method that cannot run) before the first solve.
-    const ErrorEstimatePlan plan =
-        plan_error_estimate(problem, run.mesh, reference_solve_count(problem), 1 + other_tools);
-    check_no_rigid_motion(problem, run.mesh, tool);
-    progress.stage("solving the FEM reference (P" + std::to_string(problem.parameters.fem.degree) +
-                   ", " + std::to_string(run.mesh.num_tetrahedra()) + " tetrahedra)");
-    run.fem = solve_fem(problem, run.mesh, tool);
-    run.fem_force_depth = fem_force_depth(problem, run.mesh, run.fem, tool, depths, progress);
-    const auto others_start = Clock::now();
-    for (int t = 1; t <= other_tools; ++t) {
-      other_fem.push_back(solve_fem(problem, run.mesh, problem.tools[t]));
-      progress.advance("FEM at the other tool positions", t, other_tools,
-                       seconds_since(others_start));
-    }
-    if (plan.method != cases::FemParameters::ErrorEstimate::none)
-      progress.stage("estimating the reference's own error (" + plan.note + ")");
-    run.fem_error = estimate_run_error(problem, run.mesh, plan, run.fem, other_fem);
-    if (settings.fem_cache_directory)
-      store_fem_cache(*settings.fem_cache_directory, run.fem_cache_key,
-                      {run.mesh, run.fem, run.fem_force_depth, other_fem, run.fem_error});
-  }
-  if (run.mesh.num_tetrahedra() > 0)
-    run.worst_cell_quality = fem_reference::cell_quality(run.mesh).minCoeff();
-  for (int t = 1; t <= other_tools; ++t) {
-    ToolLoad load;
-    load.tool = t;
-    load.fem = std::move(other_fem[t - 1]);
-    load.compared_vertices = unprescribed_vertices(problem, problem.tools[t]);
-    run.other_tools.push_back(std::move(load));
-  }
-}
-
-// One variant on the run's problem: pressed along the loading path at every tool, compared with
-// the FEM, timed, with its warnings.
-VariantResult run_variant(CaseRun& run, BuiltVariant& built, const std::vector<double>& path,
-                          const RunSettings& settings) {
-  const Problem& problem = run.problem;
-  const std::optional<ToolPlacement> tool =
-      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
-  VariantResult r;
-  r.nodes = built.model->num_nodes();
-  r.springs = built.model->network().num_springs();
-  r.refinement_added_nodes = built.refinement_added_nodes;
-  r.warnings = built.warnings;
-  r.parameters = variant_parameters(*built.model);
-  std::vector<ForceDepthPoint> curve;
-  const StaticSolution s = press(built, tool, path, curve);
-  static_cast<ToolLoadVariant&>(r) =
-      compare_at_tool(problem, built, s, std::move(curve), run.fem, run.compared_vertices, tool);
-  if (tool)
-    if (auto warning = buckling_warning(r.force_depth, *tool, run.fem, built.tetrahedra.rows()))
-      r.warnings.push_back(*warning);
+// The warnings a variant's result at one load raises: buckling under its tool, and at the first
+// load the metrics the reference does not resolve.
+void warn_at_load(const CaseRun& run, const BuiltVariant& built, std::size_t load,
+                  VariantResult& r) {
+  const LoadReference& reference = run.loads[load];
+  const ToolLoadVariant& result = r.loads[load];
+  if (reference.tool)
+    if (auto warning = buckling_warning(result.force_depth, *reference.tool, reference.fem,
+                                        built.tetrahedra.rows()))
+      r.warnings.push_back((load == 0 ? "" : "at tool " + std::to_string(load) + ": ") + *warning);
+  if (load != 0) return;
   std::string unresolved;
-  for (const std::string& metric : unresolved_metrics(run, r))
+  for (const std::string& metric : unresolved_metrics(run, result, load))
     unresolved += (unresolved.empty() ? "" : ", ") + metric;
   if (!unresolved.empty())
     r.warnings.push_back("not resolved by this reference: " + unresolved +
                          " within 3x of the FEM's own estimated error (a finer fem/cell "
                          "size resolves it)");
-  r.newton_iterations = s.newton_iterations;
-  r.equilibrium = s.x;
-  r.surface_displacement = s.surface_displacement;
-  r.error = s.surface_displacement - run.fem.surface_displacement;
-  if (settings.time_dynamics) r.timing = time_variant(built, problem.parameters.timing, s.x);
-  press_other_tools(run, built, path);
-  for (const ToolLoad& load : run.other_tools)
-    if (auto warning = buckling_warning(load.variants.back().force_depth, problem.tools[load.tool],
-                                        load.fem, built.tetrahedra.rows()))
-      r.warnings.push_back("at tool " + std::to_string(load.tool) + ": " + *warning);
+}
+
+// One variant on the run's problem: pressed along the loading path at every load, compared with
+// the FEM, timed from its equilibrium at the first, with its warnings.
+VariantResult run_variant(const CaseRun& run, BuiltVariant& built, const std::vector<double>& path,
+                          const RunSettings& settings) {
+  VariantResult r;
+  r.kind = built.kind;
+  r.name = built.name;
+  r.nodes = built.model->num_nodes();
+  r.springs = built.model->network().num_springs();
+  r.refinement_added_nodes = built.refinement_added_nodes;
+  r.warnings = built.warnings;
+  r.parameters = variant_parameters(*built.model);
+  // The first load on the variant itself: the timing starts from its equilibrium, pressed there.
+  r.loads.push_back(at_load(run.problem, built, run.loads.front(), path));
+  if (settings.time_dynamics)
+    r.timing = time_variant(built, run.problem.parameters.timing, r.loads.front().equilibrium);
+  press_loads(run, built, path, 1, r.loads);
+  for (std::size_t load = 0; load < r.loads.size(); ++load)
+    warn_at_load(run, built, load, r);
   return r;
 }
 
 }  // namespace
 
-void Progress::stage(const std::string& what) const {
-  if (!quiet_) std::fprintf(stderr, "msfem: %s\n", what.c_str());
-}
-
-void Progress::advance(const std::string& what, int done, int total, double elapsed_s) const {
-  if (quiet_) return;
-  const double left = done > 0 ? elapsed_s / done * (total - done) : 0.0;
-  std::fprintf(stderr, "msfem: %s %d/%d (%.0f %%, %.1f s, about %.0f s left)\n", what.c_str(), done,
-               total, 100.0 * done / total, elapsed_s, left);
+StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& tool,
+                     const std::vector<double>& path, std::vector<ForceDepthPoint>* curve) {
+  if (!tool || path.empty()) {
+    if (tool) set_tool_depth(built, *tool);
+    return solve_variant_static(built);
+  }
+  StaticSolution s;
+  Eigen::VectorXd x;
+  for (double depth : path) {
+    set_tool_depth(built, at_depth(*tool, depth));
+    StaticSolution at = solve_variant_static(built, x);
+    x = at.x;
+    if (curve) curve->push_back({depth, at.tool_force, inverted_tetrahedra(built, at.x), {}});
+    if (depth == tool->depth) s = std::move(at);
+  }
+  set_tool_depth(built, *tool);
+  return s;
 }
 
 std::vector<double> curve_depths(const cases::ToolParameters& tool) {
@@ -445,18 +347,8 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   run.problem = make_problem(parameters);
   const Problem& problem = run.problem;
   check_variants_fit(problem);
-  const std::optional<ToolPlacement> tool =
-      problem.tools.empty() ? std::nullopt : std::optional<ToolPlacement>(problem.tools.front());
-
-  std::vector<double> depths;
-  if (tool && settings.force_depth_curve) depths = curve_depths(parameters.loads.tool);
-  const int other_tools =
-      settings.all_tools ? std::max(0, static_cast<int>(problem.tools.size()) - 1) : 0;
-  reference_solutions(run, settings, depths, other_tools, progress);
-
-  run.fem_force_depth_monotone = force_grows_with_depth(run.fem_force_depth, tool);
-
-  run.compared_vertices = unprescribed_vertices(problem, tool);
+  reference_at_every_load(run, settings, progress);
+  const std::optional<ToolPlacement>& tool = run.loads.front().tool;
 
   // One loading path whatever a command writes: --no-curve skips the FEM's curve and the curves'
   // output, never the path the variants are pressed along (their equilibria would differ).
@@ -482,13 +374,10 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     }
     progress.advance("variant " + name, i + 1, total, seconds_since(variants_start));
   }
-  if (!settings.force_depth_curve) {
+  if (!settings.force_depth_curve)
     for (auto& v : run.variants)
-      v.force_depth.clear();
-    for (auto& load : run.other_tools)
-      for (auto& v : load.variants)
-        v.force_depth.clear();
-  }
+      for (auto& load : v.loads)
+        load.force_depth.clear();
   if (run.variants.empty() && !run.failed_variants.empty()) {
     std::string all;
     for (const auto& [name, why] : run.failed_variants)
@@ -507,27 +396,19 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 }
 
 std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
-                                            int load) {
+                                            std::size_t load) {
   std::vector<std::string> metrics;
-  if (load >= static_cast<int>(run.fem_error.loads.size())) return metrics;
-  const LoadErrorEstimate& estimate = run.fem_error.loads[static_cast<std::size_t>(load)];
+  if (load >= run.loads.size()) return metrics;
+  const LoadErrorEstimate& estimate = run.loads[load].fem_error;
   if (within_reference_error(variant.errors.all.rel_l2_error, estimate.rel_l2_error))
     metrics.emplace_back("rel_l2_error");
-  if (!run.problem.tools.empty() &&
+  if (run.loads[load].tool &&
       within_reference_error(variant.reaction_force_rel_error, estimate.force_rel_error))
     metrics.emplace_back("reaction_force_rel_error");
   if (variant.patch_displacement_rel_error &&
       within_reference_error(*variant.patch_displacement_rel_error, estimate.force_rel_error))
     metrics.emplace_back("patch_displacement_rel_error");
   return metrics;
-}
-
-std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& v) {
-  std::vector<ToolLoadVariant> list = {static_cast<const ToolLoadVariant&>(v)};
-  for (const auto& load : run.other_tools)
-    for (const auto& o : load.variants)
-      if (o.name == v.name) list.push_back(o);
-  return list;
 }
 
 }  // namespace msfem::compare

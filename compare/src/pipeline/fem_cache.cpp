@@ -14,7 +14,7 @@ namespace msfem::compare {
 namespace {
 
 // Bump when the FEM's formulation or the entry layout changes: old entries then miss.
-constexpr const char* cache_version = "msfem-fem-cache-6";
+constexpr const char* cache_version = "msfem-fem-cache-7";
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
   return {{"rows", m.rows()},
@@ -87,8 +87,9 @@ std::optional<fem_reference::ContactReport> contact_from(const nlohmann::json& j
 
 }  // namespace
 
-std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths,
-                          bool other_tools) {
+std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacement>& refine_near,
+                          const std::optional<ToolPlacement>& tool,
+                          const std::vector<double>& curve_depths) {
   const auto& p = problem.parameters;
   ContentHash h;
   h.text(cache_version);
@@ -104,13 +105,6 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
   h.matrix(p.support.half_space_normal);
   h.matrix(p.support.sphere_center);
   h.number(p.support.sphere_radius_m);
-  for (const auto& t : problem.tools) {
-    h.matrix(t.contact_point);
-    h.matrix(t.outward_normal);
-    h.number(t.radius);
-    h.number(t.depth);
-    if (t.frictionless) h.text("contact");  // the bonded patch's keys stay what they were
-  }
   const auto& patch = p.loads.patch_force;
   h.number(patch.enabled);
   h.matrix(patch.direction);
@@ -123,10 +117,21 @@ std::string fem_cache_key(const Problem& problem, const std::vector<double>& cur
   h.number(p.fem.refine_at_tool);
   h.number(p.fem.tool_cell_size_m);
   h.text(cases::name_of(p.fem.error_estimate));
+  h.text("mesh refined near");
+  for (const auto& t : refine_near) {
+    h.matrix(t.contact_point);
+    h.number(t.radius);
+  }
+  h.text(tool ? "tool" : "no tool");
+  if (tool) {
+    h.matrix(tool->contact_point);
+    h.matrix(tool->outward_normal);
+    h.number(tool->radius);
+    h.number(tool->depth);
+    h.text(tool->frictionless ? "contact" : "bonded");
+  }
   for (double d : curve_depths)
     h.number(d);
-  // Keys of entries without them stay what they were, so existing entries remain valid.
-  if (other_tools) h.text("other tools");
   return h.hex();
 }
 
@@ -165,18 +170,6 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
       e.force_depth.push_back(
           {p.at("depth_m"), vec_from(p.at("force_N")), std::nullopt, contact_from(p, "contact")});
     e.error_estimate = estimate_from(j.at("error_estimate"));
-    if (j.contains("other_tools"))
-      for (const auto& o : j.at("other_tools")) {
-        FemSolution t;
-        t.surface_displacement = matrix_from(o.at("surface_displacement"));
-        t.tool_force = vec_from(o.at("tool_force"));
-        t.solver = o.at("solver");
-        t.volume_change = o.at("volume_change");
-        t.statistics.iterations = o.at("iterations");
-        t.statistics.solve_time_s = o.at("solve_time_s");
-        t.contact = contact_from(o, "contact");
-        e.other_tools.push_back(std::move(t));
-      }
     return e;
   } catch (const std::exception&) {
     return std::nullopt;
@@ -216,17 +209,6 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                       {"force_depth", fd},
                       {"contact", contact_json(s.contact)},
                       {"error_estimate", estimate_json(e.error_estimate)}};
-  if (!e.other_tools.empty()) {
-    j["other_tools"] = nlohmann::json::array();
-    for (const auto& t : e.other_tools)
-      j["other_tools"].push_back({{"surface_displacement", matrix_json(t.surface_displacement)},
-                                  {"tool_force", vec(t.tool_force)},
-                                  {"solver", t.solver},
-                                  {"volume_change", t.volume_change},
-                                  {"iterations", t.statistics.iterations},
-                                  {"solve_time_s", t.statistics.solve_time_s},
-                                  {"contact", contact_json(t.contact)}});
-  }
   std::filesystem::create_directories(directory);
   const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(j);
   write_file_atomically(directory / (key + ".cbor"), [&](const std::filesystem::path& tmp) {

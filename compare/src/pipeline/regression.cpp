@@ -20,7 +20,8 @@ constexpr int format_version = 2;
 constexpr double metric_abs_tol = 1e-9, metric_rel_tol = 1e-3;
 constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the largest |u|
 
-double metric_value(const VariantResult& v, const std::string& metric) {
+// The baseline holds each variant at the run's first load.
+double metric_value(const ToolLoadVariant& v, const std::string& metric) {
   if (metric == "rel_l2_error") return v.errors.all.rel_l2_error;
   if (metric == "max_error_m") return v.errors.all.max_error_m;
   if (metric == "reaction_force_rel_error") return v.reaction_force_rel_error;
@@ -37,8 +38,9 @@ bool finite(const nlohmann::json& j) {
   return j.is_number() && std::isfinite(j.get<double>());
 }
 
-void compare_metric(const std::string& case_name, const VariantResult& v, const std::string& metric,
-                    const nlohmann::json& base, std::vector<RegressionRow>& rows) {
+void compare_metric(const std::string& case_name, const ToolLoadVariant& v,
+                    const std::string& metric, const nlohmann::json& base,
+                    std::vector<RegressionRow>& rows) {
   RegressionRow row{case_name, v.name, metric, "-", number(metric_value(v, metric)), "-", "ok"};
   const double now = metric_value(v, metric);
   if (!base.contains(metric)) {
@@ -64,8 +66,9 @@ void compare_metric(const std::string& case_name, const VariantResult& v, const 
   rows.push_back(row);
 }
 
-void compare_field(const std::string& case_name, const VariantResult& v, const nlohmann::json& base,
-                   const std::filesystem::path& fields_file, std::vector<RegressionRow>& rows) {
+void compare_field(const std::string& case_name, const ToolLoadVariant& v,
+                   const nlohmann::json& base, const std::filesystem::path& fields_file,
+                   std::vector<RegressionRow>& rows) {
   RegressionRow row{case_name, v.name, "surface_displacement", "-", "-", "-", "ok"};
   Eigen::MatrixXd reference;
   try {
@@ -139,15 +142,16 @@ nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& d
   for (const auto& v : run.variants) {
     nlohmann::json metrics = nlohmann::json::object();
     for (const auto& m : regression_metrics())
-      metrics[m] = {
-          {"value", metric_value(v, m)}, {"abs_tol", metric_abs_tol}, {"rel_tol", metric_rel_tol}};
+      metrics[m] = {{"value", metric_value(v.loads.front(), m)},
+                    {"abs_tol", metric_abs_tol},
+                    {"rel_tol", metric_rel_tol}};
     variants[v.name] = {{"metrics", metrics},
                         {"field",
                          {{"dataset", "/variants/" + v.name + "/displacement"},
                           {"units", "m"},
                           {"abs_tol_m", field_abs_tol_m},
                           {"rel_tol", field_rel_tol}}}};
-    fields.push_back({v.name, v.surface_displacement, v.error});
+    fields.push_back({v.name, v.loads.front().surface_displacement, v.loads.front().error});
   }
   const nlohmann::json baseline = {{"format_version", format_version},
                                    {"case", p.name},
@@ -161,7 +165,7 @@ nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& d
                                    {"fields_file", fields_file},
                                    {"variants", variants}};
   std::filesystem::create_directories(directory);
-  FemField fem{run.mesh.vertices, run.mesh.tetrahedra, run.fem.vertex_displacement};
+  FemField fem{run.mesh.vertices, run.mesh.tetrahedra, run.loads.front().fem.vertex_displacement};
   write_fields_h5(directory / fields_file, run.problem.surface.vertices,
                   run.problem.surface.triangles, fem, fields);
   write_text_atomically(directory / (p.name + ".json"), baseline.dump(1) + "\n");
@@ -194,8 +198,9 @@ std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohm
       continue;
     }
     for (const auto& m : regression_metrics())
-      compare_metric(p.name, v, m, variants.at(v.name).at("metrics"), rows);
-    compare_field(p.name, v, variants.at(v.name), directory / base.value("fields_file", ""), rows);
+      compare_metric(p.name, v.loads.front(), m, variants.at(v.name).at("metrics"), rows);
+    compare_field(p.name, v.loads.front(), variants.at(v.name),
+                  directory / base.value("fields_file", ""), rows);
   }
   for (const auto& [name, unused] : variants.items()) {
     bool ran = false;

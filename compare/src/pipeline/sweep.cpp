@@ -55,12 +55,11 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
   run_settings.all_tools = false;  // accuracy against speed at the case's first tool
   run_settings.fem_cache_directory = fem_cache_directory;
   const CaseRun run = run_case(p, run_settings);
-  const std::optional<ToolPlacement> tool =
-      run.problem.tools.empty() ? std::nullopt
-                                : std::optional<ToolPlacement>(run.problem.tools.front());
+  const LoadReference& load = run.loads.front();
   for (const auto& v : run.variants) {
-    const BuiltVariant built = build_variant(v.kind, run.problem, run.mesh, tool);
-    const Eigen::VectorXd& equilibrium = v.equilibrium;  // run_case's, from rest as here
+    const BuiltVariant built = build_variant(v.kind, run.problem, run.mesh, load.tool);
+    const ToolLoadVariant& at_load = v.loads.front();
+    const Eigen::VectorXd& equilibrium = at_load.equilibrium;  // run_case's, from rest as here
     for (const auto& integrator : settings.integrators) {
       cases::TimingParameters timing = p.timing;
       timing.integrator = integrator;
@@ -73,18 +72,16 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
       pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
       pt.nodes = v.nodes;
       pt.springs = v.springs;
-      pt.rel_l2_error = v.errors.all.rel_l2_error;
-      pt.reaction_force_rel_error = v.reaction_force_rel_error;
+      pt.rel_l2_error = at_load.errors.all.rel_l2_error;
+      pt.reaction_force_rel_error = at_load.reaction_force_rel_error;
       pt.stable_dt_s = t.stable_dt_s;
       pt.steps_per_second = t.steps_per_second;
       pt.realtime_factor = t.realtime_factor;
       pt.dt_s = t.dt_s;
       pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
-      if (!run.fem_error.loads.empty()) {
-        pt.fem_estimated_rel_l2_error = run.fem_error.loads.front().rel_l2_error;
-        pt.fem_estimated_force_rel_error = run.fem_error.loads.front().force_rel_error;
-      }
-      pt.not_resolved_by_reference = unresolved_metrics(run, v);
+      pt.fem_estimated_rel_l2_error = load.fem_error.rel_l2_error;
+      pt.fem_estimated_force_rel_error = load.fem_error.force_rel_error;
+      pt.not_resolved_by_reference = unresolved_metrics(run, at_load, 0);
       points.push_back(pt);
     }
   }

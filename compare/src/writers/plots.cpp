@@ -349,8 +349,8 @@ fs::path pareto(const fs::path& path, const std::string& title,
   // The legend: a filled square per colour, then a black marker per marker group.
   for (std::size_t c = 0; c < colours.size(); ++c)
     commands << ", \\\n     data index " << c << " using 1:2:3 with points pt variable ps 1.3 lc "
-             << c + 1 << " notitle, \\\n     NaN with points pt 5 ps 1.3 lc " << c + 1
-             << " title " << quoted(colours[c].empty() ? "configurations" : colours[c]);
+             << c + 1 << " notitle, \\\n     NaN with points pt 5 ps 1.3 lc " << c + 1 << " title "
+             << quoted(colours[c].empty() ? "configurations" : colours[c]);
   for (std::size_t m = 0; m < markers.size() && markers.size() > 1; ++m)
     commands << ", \\\n     NaN with points pt " << marker_types[m % 8]
              << " ps 1.3 lc 'black' title " << quoted(markers[m]);

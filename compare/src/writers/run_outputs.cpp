@@ -16,39 +16,43 @@
 namespace msfem::compare {
 namespace {
 
+// The fields of the run's first load (the one its tables show).
 void write_surfaces(const CaseRun& run, const std::filesystem::path& dir) {
   const auto& s = run.problem.surface;
+  const FemSolution& fem_solution = run.loads.front().fem;
   std::vector<std::pair<std::string, std::string>> datasets;
   write_surface_vtu(dir / "surface_fem.vtu", s.vertices, s.triangles,
-                    {{"displacement", run.fem.surface_displacement}});
+                    {{"displacement", fem_solution.surface_displacement}});
   datasets.emplace_back("surface_fem.vtu", "fem");
   for (const auto& v : run.variants) {
     const std::string file = "surface_" + v.name + ".vtu";
+    const ToolLoadVariant& own = v.loads.front();
     write_surface_vtu(dir / file, s.vertices, s.triangles,
-                      {{"displacement", v.surface_displacement},
-                       {"fem_displacement", run.fem.surface_displacement},
-                       {"error", v.error},
-                       {"error_magnitude", v.error.rowwise().norm()}});
+                      {{"displacement", own.surface_displacement},
+                       {"fem_displacement", fem_solution.surface_displacement},
+                       {"error", own.error},
+                       {"error_magnitude", own.error.rowwise().norm()}});
     datasets.emplace_back(file, v.name);
   }
   write_pvd(dir / "surfaces.pvd", datasets);
   // The FEM volume with its vertex displacements (for P2 the edge-midpoint values are left out).
   write_volume_vtu(dir / "fem.vtu", run.mesh.vertices, run.mesh.tetrahedra,
-                   {{"displacement", run.fem.vertex_displacement}});
+                   {{"displacement", fem_solution.vertex_displacement}});
   write_pvd(dir / "fem.pvd", {{"fem.vtu", "fem"}});
   // The same volume field through deal.II's HDF5 + XDMF writer (also when the FEM came from the
   // cache: the vertex displacements are all it needs).
-  fem_reference::write_vertex_displacement_hdf5(run.mesh, run.fem.vertex_displacement, dir, "fem");
+  fem_reference::write_vertex_displacement_hdf5(run.mesh, fem_solution.vertex_displacement, dir,
+                                                "fem");
 }
 
 void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
   FemField fem;
   fem.vertices = run.mesh.vertices;
   fem.tetrahedra = run.mesh.tetrahedra;
-  fem.displacement = run.fem.vertex_displacement;
+  fem.displacement = run.loads.front().fem.vertex_displacement;
   std::vector<VariantField> variants;
   for (const auto& v : run.variants)
-    variants.push_back({v.name, v.surface_displacement, v.error});
+    variants.push_back({v.name, v.loads.front().surface_displacement, v.loads.front().error});
   write_fields_h5(dir / "fields.h5", run.problem.surface.vertices, run.problem.surface.triangles,
                   fem, variants);
 }
@@ -61,10 +65,11 @@ std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::
     return lines;
   }
   std::vector<std::pair<std::string, Eigen::VectorXd>> histogram_series;
+  const std::vector<int>& compared = run.loads.front().compared_vertices;
   for (const auto& v : run.variants) {
-    Eigen::VectorXd e(run.compared_vertices.size());
-    for (std::size_t i = 0; i < run.compared_vertices.size(); ++i)
-      e[i] = 1e3 * v.error.row(run.compared_vertices[i]).norm();
+    Eigen::VectorXd e(compared.size());
+    for (std::size_t i = 0; i < compared.size(); ++i)
+      e[i] = 1e3 * v.loads.front().error.row(compared[i]).norm();
     histogram_series.emplace_back(v.name, e);
   }
   if (!histogram_series.empty()) {
@@ -72,17 +77,17 @@ std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::
                                 "|u - u_FEM| (mm)", histogram_series, 30);
     lines.push_back("![error histogram](" + file.filename().string() + ")");
   }
-  if (!run.fem_force_depth.empty()) {
+  if (!run.loads.front().force_depth.empty()) {
     std::vector<Series> series;
     Series fem{"FEM", {}, {}};
-    for (const auto& p : run.fem_force_depth) {
+    for (const auto& p : run.loads.front().force_depth) {
       fem.x.push_back(1e3 * p.depth_m);
       fem.y.push_back(p.force_n.norm());
     }
     series.push_back(fem);
     for (const auto& v : run.variants) {
       Series s{v.name, {}, {}};
-      for (const auto& p : v.force_depth) {
+      for (const auto& p : v.loads.front().force_depth) {
         s.x.push_back(1e3 * p.depth_m);
         s.y.push_back(p.force_n.norm());
       }
@@ -97,10 +102,10 @@ std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::
 
 // Each tool position of the case as its own load: rel L2 and force error per variant, and means.
 std::string tool_positions_table(const CaseRun& run) {
-  if (run.other_tools.empty()) return "";
+  if (run.loads.size() < 2) return "";
   std::ostringstream md;
   md << "\n## Every tool position (rel L2 / force err)\n\n| variant |";
-  const int tools = static_cast<int>(run.other_tools.size()) + 1;
+  const int tools = static_cast<int>(run.loads.size());
   for (int t = 0; t < tools; ++t) {
     const Eigen::Vector3d d = run.problem.parameters.loads.tool.directions[t];
     char head[96];
@@ -115,7 +120,7 @@ std::string tool_positions_table(const CaseRun& run) {
     double l2 = 0.0, force = 0.0;
     char cell[64];
     md << "| " << v.name << " |";
-    for (const ToolLoadVariant& o : per_tool(run, v)) {
+    for (const ToolLoadVariant& o : v.loads) {
       std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
                     o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
       md << cell;
@@ -133,6 +138,7 @@ std::string tool_positions_table(const CaseRun& run) {
 
 std::string report_markdown(const CaseRun& run, const std::vector<std::string>& plots) {
   const auto& p = run.problem.parameters;
+  const LoadReference& first = run.loads.front();
   std::ostringstream md;
   md << "# msfem run: " << p.name << "\n\n"
      << "- case file: `" << p.file.string() << "`\n"
@@ -141,15 +147,15 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
      << "- material: E = " << p.material.youngs_modulus_pa
      << " Pa, ν = " << p.material.poisson_ratio << ", ρ = " << p.material.density_kg_per_m3
      << " kg/m³\n"
-     << "- FEM: P" << p.fem.degree << ", " << run.fem.statistics.dofs << " dofs, "
-     << run.fem.statistics.cells << " cells, " << run.fem.statistics.iterations << " iterations, "
-     << run.fem.statistics.solve_time_s << " s solve";
+     << "- FEM: P" << p.fem.degree << ", " << first.fem.statistics.dofs << " dofs, "
+     << first.fem.statistics.cells << " cells, " << first.fem.statistics.iterations
+     << " iterations, " << first.fem.statistics.solve_time_s << " s solve";
   if (run.worst_cell_quality) md << ", worst cell quality " << *run.worst_cell_quality;
   md << "\n"
-     << "- errors over " << run.compared_vertices.size()
+     << "- errors over " << first.compared_vertices.size()
      << " surface vertices not prescribed by a support or the tool\n"
      << "- FEM result " << (run.fem_from_cache ? "reused from the cache" : "computed") << " (key "
-     << run.fem_cache_key << ")\n"
+     << first.cache_key << ")\n"
      << "- git " << git_revision() << ", " << machine_description() << "\n";
   // Variants of the same name differ with and without it: say which tables are which.
   std::string with_volume;
@@ -177,9 +183,10 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
     if (!v.timing.integrator.empty())
       std::snprintf(settle, sizeof settle, "%.3f%s", v.timing.settle_time_s,
                     v.timing.settled ? "" : " (not settled)");
+    const ToolLoadVariant& own = v.loads.front();
     std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %s |\n", v.name.c_str(),
-                  v.errors.contact_zone.rel_l2_error, v.errors.far_field.rel_l2_error,
-                  v.errors.all.mean_error_over_max_disp, v.volume_change, settle);
+                  own.errors.contact_zone.rel_l2_error, own.errors.far_field.rel_l2_error,
+                  own.errors.all.mean_error_over_max_disp, own.volume_change, settle);
     md << row;
   }
   md << tool_positions_table(run);

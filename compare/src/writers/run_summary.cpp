@@ -27,8 +27,7 @@ nlohmann::json optional_vec(const std::optional<Eigen::Vector3d>& v) {
 // The reference's own error at load `load` (nulls where it was not estimated or, for the force,
 // where no force is measured).
 nlohmann::json estimate_at(const CaseRun& run, std::size_t load) {
-  LoadErrorEstimate e;
-  if (load < run.fem_error.loads.size()) e = run.fem_error.loads[load];
+  const LoadErrorEstimate& e = run.loads[load].fem_error;
   return {{"estimated_rel_l2_error", json_or_null(e.rel_l2_error)},
           {"estimated_force_rel_error", json_or_null(e.force_rel_error)}};
 }
@@ -56,11 +55,6 @@ nlohmann::json contact_json(const std::optional<fem_reference::ContactReport>& c
           {"max_penetration_m", c->max_penetration}};
 }
 
-std::optional<ToolPlacement> tool_of(const CaseRun& run, int load) {
-  if (load >= static_cast<int>(run.problem.tools.size())) return std::nullopt;
-  return run.problem.tools[static_cast<std::size_t>(load)];
-}
-
 // The local point distribution at the tools; null where the surface is the case's own.
 nlohmann::json refinement_json(const Problem& problem) {
   if (!problem.local_refinement) return nullptr;
@@ -70,10 +64,10 @@ nlohmann::json refinement_json(const Problem& problem) {
           {"added_surface_vertices", r.added_vertices}};
 }
 
-nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o) {
+nlohmann::json load_json(const CaseRun& run, std::size_t load, const ToolLoadVariant& o) {
   const ZonedErrorMetrics& e = o.errors;
-  return {{"tool", tool},
-          {"not_resolved_by_reference", unresolved_metrics(run, o, tool)},
+  return {{"tool", load},
+          {"not_resolved_by_reference", unresolved_metrics(run, o, load)},
           {"rel_l2_error", e.all.rel_l2_error},
           {"rms_error_m", e.all.rms_error_m},
           {"max_error_m", e.all.max_error_m},
@@ -86,18 +80,18 @@ nlohmann::json load_json(const CaseRun& run, int tool, const ToolLoadVariant& o)
           {"inverted_elements", json_or_null(o.inverted_elements)},
           {"force_depth_monotone", json_or_null(o.force_depth_monotone)},
           {"force_depth_exponent",
-           json_or_null(force_depth_exponent(o.force_depth, tool_of(run, tool)))},
+           json_or_null(force_depth_exponent(o.force_depth, run.loads[load].tool))},
           {"force_depth", curve_json(o.force_depth)}};
 }
 
-// Every tool position of the case as its own load (the first is the variant's own row), with the
-// means a user comparing variants over the case wants.
+// Every tool position of the case as its own load (the first is also the variant's top-level
+// numbers), with the means a user comparing variants over the case wants.
 nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
   nlohmann::json list = nlohmann::json::array();
   double l2 = 0.0, force = 0.0;
-  const std::vector<ToolLoadVariant> loads = per_tool(run, v);
+  const std::vector<ToolLoadVariant>& loads = v.loads;
   for (std::size_t t = 0; t < loads.size(); ++t) {
-    list.push_back(load_json(run, static_cast<int>(t), loads[t]));
+    list.push_back(load_json(run, t, loads[t]));
     l2 += loads[t].errors.all.rel_l2_error;
     force += loads[t].reaction_force_rel_error;
   }
@@ -147,7 +141,8 @@ namespace {
 // The reference: its solve, its own error estimate, its force-depth curve and contact, per load.
 nlohmann::json fem_json(const CaseRun& run) {
   const auto& p = run.problem.parameters;
-  const auto& st = run.fem.statistics;
+  const LoadReference& first = run.loads.front();
+  const auto& st = first.fem.statistics;
   nlohmann::json fem = {
       {"degree", p.fem.degree},
       {"dofs", st.dofs},
@@ -156,12 +151,12 @@ nlohmann::json fem_json(const CaseRun& run) {
       {"solve_time_s", st.solve_time_s},
       {"assemble_time_s", st.assemble_time_s},
       {"iterations", st.iterations},
-      {"solver", run.fem.solver.empty() ? cases::name_of(p.fem.solver) : run.fem.solver},
+      {"solver", first.fem.solver.empty() ? cases::name_of(p.fem.solver) : first.fem.solver},
       {"mpi_ranks", st.mpi_ranks},
-      {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(run.fem.tool_force)},
-      {"volume_change", run.fem.volume_change},
+      {"reaction_force_N", first.tool ? vec(first.fem.tool_force) : nlohmann::json()},
+      {"volume_change", first.fem.volume_change},
       {"worst_cell_quality", json_or_null(run.worst_cell_quality)},
-      {"cache_key", run.fem_cache_key},
+      {"cache_key", first.cache_key},
       {"from_cache", run.fem_from_cache},
       {"error_estimate",
        {{"method", run.fem_error.method},
@@ -172,33 +167,28 @@ nlohmann::json fem_json(const CaseRun& run) {
   const std::vector<int> patch = patch_vertices(run.problem);
   fem["patch_mean_displacement_m"] =
       patch.empty() ? nlohmann::json()
-                    : vec(mean_displacement(run.fem.surface_displacement, patch));
+                    : vec(mean_displacement(first.fem.surface_displacement, patch));
   nlohmann::json curve = nlohmann::json::array();
-  for (const auto& pt : run.fem_force_depth)
+  for (const auto& pt : first.force_depth)
     curve.push_back({{"depth_m", pt.depth_m},
                      {"force_N", vec(pt.force_n)},
                      {"contact", contact_json(pt.contact)}});
   fem["force_depth"] = curve;
   fem["force_depth_monotone"] = json_or_null(run.fem_force_depth_monotone);
-  fem["force_depth_exponent"] =
-      json_or_null(force_depth_exponent(run.fem_force_depth, tool_of(run, 0)));
-  fem["contact"] = contact_json(run.fem.contact);
+  fem["force_depth_exponent"] = json_or_null(force_depth_exponent(first.force_depth, first.tool));
+  fem["contact"] = contact_json(first.fem.contact);
 
-  if (!run.other_tools.empty()) {
+  if (run.loads.size() > 1) {
     nlohmann::json loads = nlohmann::json::array();
-    loads.push_back({{"tool", 0},
-                     {"reaction_force_N", vec(run.fem.tool_force)},
-                     {"iterations", st.iterations},
-                     {"solve_time_s", st.solve_time_s},
-                     {"contact", contact_json(run.fem.contact)}});
-    loads.back().update(estimate_at(run, 0));
-    for (const auto& load : run.other_tools) {
-      loads.push_back({{"tool", load.tool},
-                       {"reaction_force_N", vec(load.fem.tool_force)},
-                       {"iterations", load.fem.statistics.iterations},
-                       {"solve_time_s", load.fem.statistics.solve_time_s},
-                       {"contact", contact_json(load.fem.contact)}});
-      loads.back().update(estimate_at(run, static_cast<std::size_t>(load.tool)));
+    for (std::size_t l = 0; l < run.loads.size(); ++l) {
+      const FemSolution& fem_at = run.loads[l].fem;
+      loads.push_back({{"tool", l},
+                       {"reaction_force_N", vec(fem_at.tool_force)},
+                       {"iterations", fem_at.statistics.iterations},
+                       {"solve_time_s", fem_at.statistics.solve_time_s},
+                       {"contact", contact_json(fem_at.contact)},
+                       {"from_cache", run.loads[l].from_cache}});
+      loads.back().update(estimate_at(run, l));
     }
     fem["loads"] = loads;
   }
@@ -207,25 +197,27 @@ nlohmann::json fem_json(const CaseRun& run) {
 
 // One variant: its errors, force, timing, force-depth curve, and (with more tools) per load.
 nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
-  const nlohmann::json fd = curve_json(v.force_depth);
+  const ToolLoadVariant& first = v.loads.front();
+  const nlohmann::json fd = curve_json(first.force_depth);
+  const bool tool = run.loads.front().tool.has_value();
   nlohmann::json j = {
       {"name", v.name},
       {"nodes", v.nodes},
       {"springs", v.springs},
       {"contact_refinement_added_nodes", json_or_null(v.refinement_added_nodes)},
-      {"rel_l2_error", v.errors.all.rel_l2_error},
-      {"rms_error_m", v.errors.all.rms_error_m},
-      {"max_error_m", v.errors.all.max_error_m},
-      {"mean_error_over_max_disp", v.errors.all.mean_error_over_max_disp},
-      {"contact_zone", zone(v.errors.contact_zone)},
-      {"far_field", zone(v.errors.far_field)},
-      {"reaction_force_N", run.problem.tools.empty() ? nlohmann::json() : vec(v.tool_force)},
+      {"rel_l2_error", first.errors.all.rel_l2_error},
+      {"rms_error_m", first.errors.all.rms_error_m},
+      {"max_error_m", first.errors.all.max_error_m},
+      {"mean_error_over_max_disp", first.errors.all.mean_error_over_max_disp},
+      {"contact_zone", zone(first.errors.contact_zone)},
+      {"far_field", zone(first.errors.far_field)},
+      {"reaction_force_N", tool ? vec(first.tool_force) : nlohmann::json()},
       {"reaction_force_rel_error",
-       run.problem.tools.empty() ? nlohmann::json() : nlohmann::json(v.reaction_force_rel_error)},
-      {"volume_change", v.volume_change},
-      {"patch_mean_displacement_m", optional_vec(v.patch_mean_displacement)},
-      {"patch_displacement_rel_error", json_or_null(v.patch_displacement_rel_error)},
-      {"not_resolved_by_reference", unresolved_metrics(run, v)},
+       tool ? nlohmann::json(first.reaction_force_rel_error) : nlohmann::json()},
+      {"volume_change", first.volume_change},
+      {"patch_mean_displacement_m", optional_vec(first.patch_mean_displacement)},
+      {"patch_displacement_rel_error", json_or_null(first.patch_displacement_rel_error)},
+      {"not_resolved_by_reference", unresolved_metrics(run, first, 0)},
       {"integrator", v.timing.integrator},
       {"dt_s", v.timing.dt_s},
       {"steps_per_second", v.timing.steps_per_second},
@@ -235,14 +227,15 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"settle_time_s", v.timing.settle_time_s},
       {"settled", v.timing.settled},
       {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
-      {"newton_iterations", v.newton_iterations},
+      {"newton_iterations", first.newton_iterations},
       {"force_depth", fd},
-      {"force_depth_monotone", json_or_null(v.force_depth_monotone)},
-      {"force_depth_exponent", json_or_null(force_depth_exponent(v.force_depth, tool_of(run, 0)))},
-      {"inverted_elements", json_or_null(v.inverted_elements)},
+      {"force_depth_monotone", json_or_null(first.force_depth_monotone)},
+      {"force_depth_exponent",
+       json_or_null(force_depth_exponent(first.force_depth, run.loads.front().tool))},
+      {"inverted_elements", json_or_null(first.inverted_elements)},
       {"warnings", v.warnings},
       {"parameters", v.parameters}};
-  if (!run.other_tools.empty()) j["loads"] = variant_loads(run, v);
+  if (run.loads.size() > 1) j["loads"] = variant_loads(run, v);
   return j;
 }
 
@@ -284,7 +277,7 @@ nlohmann::json summary_json(const CaseRun& run) {
             {"vertices", run.problem.surface.num_vertices()},
             {"triangles", run.problem.surface.num_triangles()}}},
           {"contact_refinement", refinement_json(run.problem)},
-          {"compared_vertices", run.compared_vertices.size()},
+          {"compared_vertices", run.loads.front().compared_vertices.size()},
           {"tools", tools},
           {"notes", run.problem.notes},
           {"fem", fem},
@@ -310,7 +303,7 @@ bool contains(const std::vector<std::string>& list, const std::string& item) {
 std::string table_notes(const CaseRun& run) {
   std::ostringstream out;
   const FemErrorEstimate& e = run.fem_error;
-  const LoadErrorEstimate first = e.loads.empty() ? LoadErrorEstimate{} : e.loads.front();
+  const LoadErrorEstimate& first = run.loads.front().fem_error;
   if (first.rel_l2_error) {
     char line[512];
     std::snprintf(
@@ -321,24 +314,27 @@ std::string table_notes(const CaseRun& run) {
         first.force_rel_error ? error_cell(*first.force_rel_error, false).c_str() : "-");
     out << line;
     if (std::any_of(run.variants.begin(), run.variants.end(),
-                    [&](const auto& v) { return !unresolved_metrics(run, v).empty(); }))
+                    [&](const auto& v) { return !unresolved_metrics(run, v.loads[0], 0).empty(); }))
       out << "‡ within 3x of the reference's own error: not resolved by this reference\n";
   } else {
     out << "FEM reference's own error: " << e.note << "\n";
   }
   const std::vector<int> patch = patch_vertices(run.problem);
   if (!patch.empty()) {
-    const Eigen::Vector3d fem = mean_displacement(run.fem.surface_displacement, patch);
+    const Eigen::Vector3d fem =
+        mean_displacement(run.loads.front().fem.surface_displacement, patch);
     char line[256];
     std::snprintf(line, sizeof line, "patch force on %zu vertices: mean displacement FEM %.3f mm",
                   patch.size(), 1e3 * fem.norm());
     out << line;
     for (const auto& v : run.variants) {
-      std::snprintf(line, sizeof line, "; %s %.3f mm (err %s)", v.name.c_str(),
-                    1e3 * v.patch_mean_displacement->norm(),
-                    error_cell(*v.patch_displacement_rel_error,
-                               contains(unresolved_metrics(run, v), "patch_displacement_rel_error"))
-                        .c_str());
+      const ToolLoadVariant& own = v.loads.front();
+      std::snprintf(
+          line, sizeof line, "; %s %.3f mm (err %s)", v.name.c_str(),
+          1e3 * own.patch_mean_displacement->norm(),
+          error_cell(*own.patch_displacement_rel_error,
+                     contains(unresolved_metrics(run, own, 0), "patch_displacement_rel_error"))
+              .c_str());
       out << line;
     }
     out << "\n";
@@ -359,14 +355,15 @@ std::string variant_table(const CaseRun& run) {
   out << "|--------------|--------|---------|-----------|-----------|-----------|-----------|------"
          "------|-----------|-----------|\n";
   // Without a tool no force is measured: dashes, not a zero that reads as a perfect force.
-  const bool tool = !run.problem.tools.empty();
+  const LoadReference& reference = run.loads.front();
+  const bool tool = reference.tool.has_value();
   char fem_force[32] = "-";
-  if (tool) std::snprintf(fem_force, sizeof fem_force, "%.4g", run.fem.tool_force.norm());
+  if (tool) std::snprintf(fem_force, sizeof fem_force, "%.4g", reference.fem.tool_force.norm());
   std::snprintf(line, sizeof line,
                 "| %-12s | %6zu | %7s | %9s | %9s | %9s | %9s | %10s | %9s | %9s |\n",
                 ("FEM P" + std::to_string(run.problem.parameters.fem.degree)).c_str(),
-                static_cast<std::size_t>(run.fem.statistics.vertices), "-", "-", "-", fem_force,
-                "-", "-", "-", "-");
+                static_cast<std::size_t>(reference.fem.statistics.vertices), "-", "-", "-",
+                fem_force, "-", "-", "-", "-");
   out << line;
   for (const auto& v : run.variants) {
     // Not timed (--no-timing): dashes, not zeros that read as measurements.
@@ -377,18 +374,19 @@ std::string variant_table(const CaseRun& run) {
       std::snprintf(dt, sizeof dt, "%.3g", v.timing.stable_dt_s);
       std::snprintf(frame, sizeof frame, "%.3f", v.timing.ms_per_60hz_frame);
     }
-    const std::vector<std::string> unresolved = unresolved_metrics(run, v);
+    const ToolLoadVariant& own = v.loads.front();
+    const std::vector<std::string> unresolved = unresolved_metrics(run, own, 0);
     std::string force_error = "-";
     if (tool) {
-      std::snprintf(force, sizeof force, "%.4g", v.tool_force.norm());
-      force_error =
-          error_cell(v.reaction_force_rel_error, contains(unresolved, "reaction_force_rel_error"));
+      std::snprintf(force, sizeof force, "%.4g", own.tool_force.norm());
+      force_error = error_cell(own.reaction_force_rel_error,
+                               contains(unresolved, "reaction_force_rel_error"));
     }
     std::snprintf(
         line, sizeof line, "| %-12s | %6d | %7d | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
         v.name.c_str(), v.nodes, v.springs,
-        error_cell(v.errors.all.rel_l2_error, contains(unresolved, "rel_l2_error")).c_str(),
-        1e3 * v.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
+        error_cell(own.errors.all.rel_l2_error, contains(unresolved, "rel_l2_error")).c_str(),
+        1e3 * own.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
     out << line;
   }
   out << table_notes(run);

@@ -23,7 +23,7 @@
 namespace msfem::compare {
 
 /// What the model is compared with on one load: the reference surface displacement and tool force.
-struct LoadReference {
+struct CalibrationLoad {
   cases::ToolLoad load;
   ToolPlacement tool;
   Eigen::MatrixX3d surface_displacement;  ///< n_surface x 3, m
@@ -97,18 +97,19 @@ struct CalibrationFit {
 /// Throws cases::InputError naming `problem.parameters.file` for an unknown group or an empty
 /// training set, std::runtime_error if a static solve fails.
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                         cases::Variant variant, const std::vector<LoadReference>& train,
-                         const std::vector<LoadReference>& test, const CalibrationOptions& options);
+                         cases::Variant variant, const std::vector<CalibrationLoad>& train,
+                         const std::vector<CalibrationLoad>& test,
+                         const CalibrationOptions& options);
 
 /// Errors of a built variant on one reference (its tool set to the reference's), with the static
 /// solve warm-started from `x` when it has the right size, or under a frictionless tool pressed
 /// from rest along quarters of its depth (finer with `path_step`, m), as msfem run presses; `x` is
 /// updated to the equilibrium.
-LoadErrors evaluate_load(BuiltVariant& variant, const LoadReference& reference, Eigen::VectorXd& x,
-                         double path_step);
+LoadErrors evaluate_load(BuiltVariant& variant, const CalibrationLoad& reference,
+                         Eigen::VectorXd& x, double path_step);
 
 /// The same on the model linearised at rest (one Cholesky factorisation); throws
 /// std::runtime_error where that stiffness is singular.
-LoadErrors evaluate_load_linear(BuiltVariant& variant, const LoadReference& reference);
+LoadErrors evaluate_load_linear(BuiltVariant& variant, const CalibrationLoad& reference);
 
 }  // namespace msfem::compare

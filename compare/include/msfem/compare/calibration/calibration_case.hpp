@@ -40,7 +40,7 @@ struct CaseCalibration {
   cases::Variant variant = cases::Variant::three_tier;
   CalibrationOptions options;
   double target_damping_ratio = 0.0;
-  std::vector<LoadReference> train, test;
+  std::vector<CalibrationLoad> train, test;
   CalibrationFit fit;
   massspring::DampingFit damping;
   LoadErrors

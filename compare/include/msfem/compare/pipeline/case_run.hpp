@@ -1,6 +1,8 @@
 #pragma once
-// `msfem run`: the FEM once per load and every variant to static equilibrium on the same problem,
-// with errors, forces and timings, gathered for the writers (run_outputs.hpp).
+// `msfem run`: the harness's one per-load loop. For each load (each tool position of the case),
+// the FEM reference through one cache (fem_references.hpp); for each variant, pressed along the
+// loading path at every load and measured against it, and timed; gathered for the writers
+// (run_outputs.hpp). msfem sweep and msfem regress consume it as it is.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "msfem/compare/pipeline/fem_error_estimate.hpp"
+#include "msfem/compare/pipeline/fem_references.hpp"
 #include "msfem/compare/pipeline/fem_run.hpp"
 #include "msfem/compare/pipeline/metrics.hpp"
 #include "msfem/compare/pipeline/problem.hpp"
@@ -19,28 +22,8 @@
 
 namespace msfem::compare {
 
-/// Progress lines on stderr ("stage, percent, time left"); silent when quiet.
-class Progress {
- public:
-  explicit Progress(bool quiet) : quiet_(quiet) {}
-  void stage(const std::string& what) const;
-  /// Item `done` of `total` finished, `elapsed_s` since the stage began.
-  void advance(const std::string& what, int done, int total, double elapsed_s) const;
-
- private:
-  bool quiet_;
-};
-
-struct ForceDepthPoint {
-  double depth_m = 0.0;
-  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
-  std::optional<int> inverted_elements;  ///< a volumetric variant's inverted tetrahedra there
-  std::optional<fem_reference::ContactReport> contact;  ///< the FEM's frictionless tool there
-};
-
-/// One variant pressed at one of the case's tool positions, at the case's depth, reached along the
-/// loading path: alone for the second and later `loads/tool/directions`, within VariantResult for
-/// the first.
+/// One variant pressed at one load of the run (a tool position of the case, at the case's depth,
+/// reached along the loading path; or the case's gravity or patch force).
 struct ToolLoadVariant {
   cases::Variant kind = cases::Variant::three_tier;
   std::string name;  ///< kind's name
@@ -55,28 +38,22 @@ struct ToolLoadVariant {
   /// and its error against the FEM's, |ū − ū_FEM| / |ū_FEM|.
   std::optional<Eigen::Vector3d> patch_mean_displacement;
   std::optional<double> patch_displacement_rel_error;
-};
-
-/// The variant at the run's own (first) tool position, with what only that load gets.
-struct VariantResult : ToolLoadVariant {
-  int nodes = 0, springs = 0;
-  std::optional<int> refinement_added_nodes;  ///< BuiltVariant's
-  Timing timing;
   int newton_iterations = 0;
-  nlohmann::json parameters;  ///< group stiffness, damping, masses as used
-  std::vector<std::string> warnings;
-  Eigen::VectorXd equilibrium;            ///< every node's position at the case's load, m
+  Eigen::VectorXd equilibrium;            ///< every node's position, m
   Eigen::MatrixX3d surface_displacement;  ///< at the surface vertices, m
   Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
 };
 
-/// The FEM and every variant pressed at problem.tools[tool], tool >= 1 (tool 0 is the run's own
-/// load: CaseRun::fem and CaseRun::variants).
-struct ToolLoad {
-  int tool = 0;
-  FemSolution fem;  ///< surface displacement, force and statistics
-  std::vector<int> compared_vertices;
-  std::vector<ToolLoadVariant> variants;
+/// One variant over the run: what it is, how fast it runs, and its result at every load.
+struct VariantResult {
+  cases::Variant kind = cases::Variant::three_tier;
+  std::string name;  ///< kind's name
+  int nodes = 0, springs = 0;
+  std::optional<int> refinement_added_nodes;  ///< BuiltVariant's
+  Timing timing;                              ///< from its equilibrium at the first load
+  nlohmann::json parameters;                  ///< group stiffness, damping, masses as used
+  std::vector<std::string> warnings;
+  std::vector<ToolLoadVariant> loads;  ///< one per CaseRun::loads, in that order
 };
 
 struct CaseRun {
@@ -84,19 +61,18 @@ struct CaseRun {
   fem_reference::VolumeMesh mesh;
   /// The mesh's worst tetrahedron (fem_reference::cell_quality): CG's iterations follow it.
   std::optional<double> worst_cell_quality;
-  FemSolution fem;
-  std::vector<ForceDepthPoint> fem_force_depth;
-  std::optional<bool> fem_force_depth_monotone;
+  /// The run's loads, each tool position of the case in order (one load without a tool): the
+  /// FEM there, its force-depth curve (the first load's) and its own estimated error. The first is
+  /// what summary.json's top-level numbers, report.md's table and the fields show.
+  std::vector<LoadReference> loads;
+  std::optional<bool> fem_force_depth_monotone;  ///< the first load's FEM curve
   std::vector<VariantResult> variants;
   /// Variants whose statics or dynamics failed (a solver, not the input): name and message. The
   /// others are still compared; bad input stops the whole run.
   std::vector<std::pair<std::string, std::string>> failed_variants;
-  std::vector<int> compared_vertices;  ///< surface vertices not prescribed by a support or the tool
-  std::vector<ToolLoad> other_tools;   ///< the case's second and later tool positions
-  FemErrorEstimate fem_error;          ///< the reference's own error, per load
+  FemErrorEstimate fem_error;  ///< how the reference's own error was estimated (values per load)
   double wall_time_s = 0.0;
-  std::string fem_cache_key;
-  bool fem_from_cache = false;
+  bool fem_from_cache = false;  ///< every load's FEM came from the cache
 };
 
 struct RunSettings {
@@ -113,6 +89,15 @@ struct RunSettings {
 /// when a solver fails.
 CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& settings);
 
+/// The variant's equilibrium with `tool` at its depth. With a path, a quasi-static loading path,
+/// each depth started from the last, as a tool pressed in steps is: a network with several
+/// equilibria (one that buckles under the tool) then stays on the branch a simulator would follow.
+/// Every step is a point of `curve` when one is given (a fall between two curve depths must not go
+/// unseen). The path ends at the tool's depth; the variant is left pressed there.
+StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& tool,
+                     const std::vector<double>& path,
+                     std::vector<ForceDepthPoint>* curve = nullptr);
+
 /// Force-depth depths of a tool: the case's list, or a quarter, half, three quarters and all of it.
 std::vector<double> curve_depths(const cases::ToolParameters& tool);
 
@@ -120,14 +105,10 @@ std::vector<double> curve_depths(const cases::ToolParameters& tool);
 /// increasing order, with equal steps no longer than `step` (> 0) inserted from 0 up to each.
 std::vector<double> loading_path(std::vector<double> depths, double case_depth, double step);
 
-/// The variant at every tool position of the run, in tool order: tool 0 from its own result, then
-/// the other tools' (what summary.json's `loads` and report.md's per-tool table show).
-std::vector<ToolLoadVariant> per_tool(const CaseRun& run, const VariantResult& variant);
-
 /// The metrics (summary.json names) of `variant` at load `load` that lie within 3x the reference's
 /// own estimated error there: the reference does not resolve the variant's error in them.
 std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
-                                            int load = 0);
+                                            std::size_t load);
 
 /// The exponent n of the power law F = c d^n fitted (least squares in log-log) to the curve's
 /// force along the tool's outward normal: 1.5 for Hertz, 1 for a linear spring. None without a

@@ -9,24 +9,24 @@
 #include <string>
 #include <vector>
 
-#include "msfem/compare/pipeline/case_run.hpp"
+#include "msfem/compare/pipeline/fem_references.hpp"
 
 namespace msfem::compare {
 
-/// What a run needs of the FEM.
+/// The FEM at one load.
 struct FemCacheEntry {
-  fem_reference::VolumeMesh mesh;
+  fem_reference::VolumeMesh mesh;  ///< the one mesh of every load of the command
   FemSolution solution;
   std::vector<ForceDepthPoint> force_depth;
-  /// The problem's second and later tools at full depth (surface displacement, force, statistics).
-  std::vector<FemSolution> other_tools;
-  FemErrorEstimate error_estimate;  ///< the reference's own error (fem/error estimate)
+  /// The reference's own error (fem/error estimate): method and cost, and this load's values.
+  FemErrorEstimate error_estimate;
 };
 
-/// 16 hex digits of a 64-bit FNV-1a hash of the problem's FEM inputs and the curve depths, and
-/// whether the entry holds the other tools' solutions too.
-std::string fem_cache_key(const Problem& problem, const std::vector<double>& curve_depths,
-                          bool other_tools = false);
+/// 16 hex digits of a 64-bit FNV-1a hash of what the FEM at one load depends on: the problem's FEM
+/// inputs, where its mesh is refined, the load's tool and its force-depth curve's depths.
+std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacement>& refine_near,
+                          const std::optional<ToolPlacement>& tool,
+                          const std::vector<double>& curve_depths);
 
 /// The entry for `key` under `directory`, or none (missing or unreadable: a stale or damaged
 /// entry is recomputed, never trusted).
