@@ -138,8 +138,8 @@ void declare_mass_spring(ParameterHandler& prm) {
                     "Tier 3 (fixed) is the surface scaled by 1/scale.");
   prm.declare_entry("inner tiers", "scaled",
                     Patterns::Selection(selection_of<massspring::InnerTierMethod>()),
-                    "Build inner tiers by scaling, or by offsetting along the inward normal "
-                    "(safe for concave surfaces).");
+                    "scaled (the seed), offset along the inward normal, or distance_field (no "
+                    "prism folds, no tier leaves the one above; shallow in thin folds).");
   prm.declare_entry("inner diagonals", "false", Patterns::Bool(),
                     "Crossing diagonals between tier 2 and tier 3 as between tiers 1 and 2 "
                     "(group tier23_diagonals). The seed links tier 2 to the fixed tier 3 by radial "

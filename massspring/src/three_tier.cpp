@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "builder_support.hpp"
+#include "inner_tiers.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/surface_geometry.hpp"
 #include "msfem/massspring/topology_builders.hpp"
@@ -12,14 +14,15 @@ namespace msfem::massspring {
 namespace {
 
 void check_options(const ThreeTierOptions& options) {
-  if (options.inner_tiers == InnerTierMethod::scaling) {
+  if (options.inner_tiers != InnerTierMethod::normal_offset) {
     if (!std::isfinite(options.tier2_scale) || !(options.tier2_scale > 1.0))
       throw ModelError("three_tier tier2_scale " + std::to_string(options.tier2_scale) +
                        " must be finite and > 1");
     if (!std::isfinite(options.tier3_scale) || !(options.tier3_scale > options.tier2_scale))
       throw ModelError("three_tier tier3_scale " + std::to_string(options.tier3_scale) +
                        " must be finite and > tier2_scale");
-  } else {
+  }
+  if (options.inner_tiers != InnerTierMethod::scaling) {
     if (!std::isfinite(options.tier2_offset) || !std::isfinite(options.tier3_offset))
       throw ModelError("three_tier tier offsets must be finite");
     if (options.tier2_offset > 0.0 && options.tier3_offset > 0.0 &&
@@ -29,14 +32,28 @@ void check_options(const ThreeTierOptions& options) {
   }
 }
 
-// Inner tier k by scaling about the centroid or by offset along the inward normal.
-Eigen::MatrixX3d inner_tier(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3d& normals,
-                            const Eigen::Vector3d& centroid, double mean_radius,
-                            const ThreeTierOptions& options, double scale, double offset) {
-  if (options.inner_tiers == InnerTierMethod::scaling)
-    return ((vertices.rowwise() - centroid.transpose()) / scale).rowwise() + centroid.transpose();
-  const double depth = offset > 0.0 ? offset : (1.0 - 1.0 / scale) * mean_radius;
-  return vertices - depth * normals;
+// Tiers 2 and 3 by the chosen method. The depths along the normal default to those of the scaling
+// on a sphere of the surface's mean radius about c.
+detail::DistanceFieldTiers inner_tiers(const Eigen::MatrixX3d& vertices,
+                                       const Eigen::MatrixX3i& triangles,
+                                       const ThreeTierOptions& options,
+                                       const Eigen::Vector3d& centroid) {
+  const double scales[2] = {options.tier2_scale, options.tier3_scale};
+  if (options.inner_tiers == InnerTierMethod::scaling) {
+    const auto scaled = [&](double s) -> Eigen::MatrixX3d {
+      return ((vertices.rowwise() - centroid.transpose()) / s).rowwise() + centroid.transpose();
+    };
+    return {scaled(scales[0]), scaled(scales[1]), {}};
+  }
+  const double mean_radius = (vertices.rowwise() - centroid.transpose()).rowwise().norm().mean();
+  const double offsets[2] = {options.tier2_offset, options.tier3_offset};
+  double depth[2];
+  for (int k = 0; k < 2; ++k)
+    depth[k] = offsets[k] > 0.0 ? offsets[k] : (1.0 - 1.0 / scales[k]) * mean_radius;
+  const Eigen::MatrixX3d normals = vertex_normals(vertices, triangles);
+  if (options.inner_tiers == InnerTierMethod::distance_field)
+    return detail::distance_field_tiers(vertices, triangles, normals, depth[0], depth[1]);
+  return {vertices - depth[0] * normals, vertices - depth[1] * normals, {}};
 }
 
 // Reports inner-tier nodes found outside the next outer tier.
@@ -73,9 +90,11 @@ void check_nesting(SpringNetwork& network, const Eigen::MatrixX3d& inner,
       std::to_string(inner.rows()) + " " + inner_name + " nodes (first: vertex " +
       std::to_string(outside.front()) + ") lie outside " + outer_name +
       (method == InnerTierMethod::scaling
-           ? "; scaling a concave surface does that, use InnerTierMethod::normal_offset"
-           : "; an inward offset deeper than the surface's folds are wide folds the tier over "
-             "itself, use smaller tier offsets or a smoothed surface");
+           ? "; scaling a concave surface does that, use InnerTierMethod::distance_field"
+       : method == InnerTierMethod::normal_offset
+           ? "; an inward offset deeper than the surface's folds are wide folds the tier over "
+             "itself, use InnerTierMethod::distance_field"
+           : "; the distance field's depth reduction could not mend it");
   if (reject) throw ModelError(message);
   network.warnings.push_back(message);
 }
@@ -90,14 +109,12 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
 
   const int nv = static_cast<int>(vertices.rows());
   const Eigen::Vector3d centroid = options.center.value_or(vertex_centroid(vertices));
-  const Eigen::MatrixX3d normals = vertex_normals(vertices, triangles);
-  const double mean_radius = (vertices.rowwise() - centroid.transpose()).rowwise().norm().mean();
-  const Eigen::MatrixX3d tier2 = inner_tier(vertices, normals, centroid, mean_radius, options,
-                                            options.tier2_scale, options.tier2_offset);
-  const Eigen::MatrixX3d tier3 = inner_tier(vertices, normals, centroid, mean_radius, options,
-                                            options.tier3_scale, options.tier3_offset);
+  detail::DistanceFieldTiers built = inner_tiers(vertices, triangles, options, centroid);
+  const Eigen::MatrixX3d& tier2 = built.tier2;
+  const Eigen::MatrixX3d& tier3 = built.tier3;
 
   SpringNetwork network;
+  network.warnings = std::move(built.warnings);
   check_nesting(network, tier2, vertices, triangles, "tier 2", "tier 1", options.inner_tiers,
                 options.reject_inner_tier_outside);
   check_nesting(network, tier3, tier2, triangles, "tier 3", "tier 2", options.inner_tiers,

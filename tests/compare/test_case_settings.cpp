@@ -163,6 +163,12 @@ TEST(CaseSettings, VariantStiffnessModelAndInnerTiersChangeTheNetwork) {
   const auto offset =
       network_with("mass spring/three tier/inner tiers=offset", cases::Variant::three_tier);
   EXPECT_GT((scaled.rest_positions - offset.rest_positions).norm(), 1e-4);
+  // On a convex ellipsoid the distance field's copies go along the normals, not toward the
+  // centroid.
+  const auto field =
+      network_with("mass spring/three tier/inner tiers=distance_field", cases::Variant::three_tier);
+  EXPECT_GT((scaled.rest_positions - field.rest_positions).norm(), 1e-4);
+  EXPECT_GT((offset.rest_positions - field.rest_positions).norm(), 1e-6);
 }
 
 // The three linear solvers give the same reference, each naming itself.

@@ -104,7 +104,8 @@ struct MassSpringParameters {
   bool volume_preservation = false;
   double middle_tier_scale = 1.2;
   double inner_tier_scale = 2.0;
-  /// scaled about the centroid (the seed) or offset along the inward normal
+  /// scaled about the centroid (the seed), offset along the inward normal, or along the distance
+  /// field's ascent (InnerTierMethod::distance_field: never folds)
   massspring::InnerTierMethod inner_tiers = massspring::InnerTierMethod::scaling;
   bool inner_diagonals = false;        ///< tier 2 to tier 3 crossing diagonals (not the seed's)
   int skeleton_control_points = 0;     ///< 0: a tenth of the surface vertices, at least 20

@@ -40,9 +40,10 @@ inline constexpr NameTable<massspring::TetStiffnessRule, 2> stiffness_model_tabl
     {massspring::TetStiffnessRule::van_gelder, "van_gelder"},
 }}};
 
-inline constexpr NameTable<massspring::InnerTierMethod, 2> inner_tiers_table{{{
+inline constexpr NameTable<massspring::InnerTierMethod, 3> inner_tiers_table{{{
     {massspring::InnerTierMethod::scaling, "scaled"},
     {massspring::InnerTierMethod::normal_offset, "offset"},
+    {massspring::InnerTierMethod::distance_field, "distance_field"},
 }}};
 
 inline constexpr NameTable<ToolParameters::Mode, 3> tool_mode_table{{{

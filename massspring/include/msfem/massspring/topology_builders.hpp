@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 #include "msfem/massspring/spring_network.hpp"
 
@@ -20,8 +21,23 @@ struct Material {
 /// tiers 1 and 2, two crossing diagonals per edge between tiers 1 and 2 (a1-b2, b1-a2), one radial
 /// spring per vertex between tiers 1-2 and 2-3: 4E + 2V springs, 3V nodes.
 enum class InnerTierMethod {
-  scaling,       ///< x_k = c + (x - c) / s_k about the vertex centroid c (the seed)
-  normal_offset  ///< x_k = x - δ_k n(x) along the inward vertex normal
+  scaling,        ///< x_k = c + (x - c) / s_k about the vertex centroid c (the seed)
+  normal_offset,  ///< x_k = x - δ_k n(x) along the inward vertex normal
+  /// x_k = x - t_k(x) n(x): the distance field's gradient flow from the vertex inwards, which
+  /// runs straight along the inward normal n until it meets the medial axis at the depth r(x) of
+  /// the largest ball inside the surface that touches x (a ball that holds no other surface
+  /// vertex, found by shrinking). Tier 3 stops at t_3 = min(δ_3, 0.8 r), short of the medial axis,
+  /// so the copies of a fold's two walls never meet and no node is merged (3V nodes and 4E + 2V
+  /// springs, as the seed's); tier 2 at t_2 = (δ_2/δ_3) t_3, the same fraction of its own depth.
+  /// δ_k are the normal_offset depths, so on a sphere (r = the radius) these are the scaled
+  /// tiers; in a narrow fold (the cortex's gyri) the tiers stay inside the fold and are shallow.
+  /// The depths vary from vertex to vertex, so t_3 may change by at most half the distance along
+  /// the surface, and where a shell prism still has a tetrahedron of non-positive volume or a tier
+  /// triangle turned against its tier-1 triangle (inverted_tier_prisms), or a node lies outside
+  /// the tier above (points_outside_surface), its vertices' depths shrink until none does. At a
+  /// pinched vertex whose normal disagrees with one of its own triangles the copy moves along the
+  /// direction that agrees best with all of them. A fault that remains is a warning.
+  distance_field
 };
 
 struct ThreeTierOptions {
@@ -56,6 +72,12 @@ struct ThreeTierOptions {
 /// following the vertex areas at its ends (so a locally refined surface is not stiffer there).
 SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
                                const ThreeTierOptions& options = {});
+
+/// The triangles f whose prism between `outer` and `inner` (tier_prisms' nine tetrahedra, all
+/// three splits) has a tetrahedron whose volume does not have the orientation of a shell below an
+/// outward-oriented surface, or whose inner triangle turns against the outer one: a folded prism.
+std::vector<int> inverted_tier_prisms(const Eigen::MatrixX3d& outer, const Eigen::MatrixX3d& inner,
+                                      const Eigen::MatrixX3i& triangles);
 
 /// --- single_layer ---
 /// Surface edges only (group "surface_edges"). With anchor_to_rest, every node is also tied to its
