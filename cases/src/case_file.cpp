@@ -521,38 +521,6 @@ void load_case(const std::filesystem::path& file, const std::vector<std::string>
 
 }  // namespace
 
-std::string ToolLoad::label() const {
-  std::ostringstream out;
-  out << direction.x() << ',' << direction.y() << ',' << direction.z() << '@' << depth_m;
-  return out.str();
-}
-
-bool ToolLoad::same_as(const ToolLoad& other) const {
-  return (direction - other.direction).norm() < 1e-9 && std::abs(depth_m - other.depth_m) < 1e-12;
-}
-
-std::vector<ToolLoad> parse_tool_loads(const std::string& text, const std::string& key) {
-  std::vector<ToolLoad> loads;
-  for (const auto& entry : dealii::Utilities::split_string_list(text, ';')) {
-    const auto at = entry.find('@');
-    ToolLoad load;
-    try {
-      if (at == std::string::npos) throw InputError("no '@'");
-      load.direction = unit_vector(entry.substr(0, at), key);
-      std::size_t used = 0;
-      const std::string depth = dealii::Utilities::trim(entry.substr(at + 1));
-      load.depth_m = std::stod(depth, &used);
-      if (used != depth.size() || !(load.depth_m > 0) || !std::isfinite(load.depth_m))
-        throw InputError("bad depth");
-    } catch (const std::exception&) {
-      throw InputError(key + ": '" + entry +
-                       "' is not DX,DY,DZ@DEPTH with a non-zero direction and a depth > 0 (m)");
-    }
-    loads.push_back(load);
-  }
-  return loads;
-}
-
 CaseParameters read_case(const std::filesystem::path& file,
                          const std::vector<std::string>& overrides) {
   ParameterHandler prm;
