@@ -41,6 +41,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))} {
+    take_fields(model);
     pack();
   }
 
@@ -49,6 +50,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     soa_.load_parameters(model);
     gather_.load_parameters(soa_);
     model_ = &model;
+    take_fields(model);
     pack();
   }
   void set_state(const State& state) override {
@@ -69,7 +71,13 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
   void step(double dt, int count) override {
     check_time_step(dt);
+    step_springs(dt, count);
+  }
+
+ private:
+  void step_springs(double dt, int count) {
     const Real h = static_cast<Real>(dt);
+    field_diverged_ = false;
     std::vector<double> check(team_.size(), 0.0);
     // Blocks are taken from one ticket counter. In each step every member draws tickets until it
     // gets one past the step's blocks, so a step uses exactly blocks + members tickets and the
@@ -91,6 +99,12 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
           sum += kernels_.explicit_step(gather_, cur, next, begin, end, h);
         }
         from = 1 - from;
+        // A field's force is read from the step's start like the springs' and added to the new
+        // state once every member has written it, by one member while the others wait.
+        if (!fields_.empty()) {
+          team_.barrier();
+          if (member == 0) add_field_impulses(dt, records_[1 - from].data(), records_[from].data());
+        }
         if (n + 1 < count) team_.barrier();  // run() itself waits for the last step
       }
       check[member] = sum;
@@ -101,14 +115,59 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     double total = 0.0;
     for (double value : check)
       total += value;
-    if (!std::isfinite(total)) report_divergence(dt);
+    if (!std::isfinite(total) || field_diverged_) report_divergence(dt);
   }
 
+ public:
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
   int threads() const override { return team_.size(); }
 
  private:
+  // The model's force fields and the nodes they read and push: gathered into full-size vectors
+  // at those nodes only, so a field on a few nodes (the tool's contact) costs a step little.
+  void take_fields(const MassSpringModel& model) {
+    fields_.clear();
+    std::vector<char> used(static_cast<std::size_t>(soa_.num_nodes), 0);
+    for (const auto& field : model.fields()) {
+      fields_.push_back(field.field);
+      for (int node : field.field->nodes())
+        used[static_cast<std::size_t>(node)] = 1;
+    }
+    field_nodes_.clear();
+    for (int node = 0; node < soa_.num_nodes; ++node)
+      if (used[static_cast<std::size_t>(node)]) field_nodes_.push_back(node);
+    const Eigen::Index dofs = 3 * static_cast<Eigen::Index>(soa_.num_nodes);
+    field_x_ = Eigen::VectorXd::Zero(fields_.empty() ? 0 : dofs);
+    field_v_ = field_x_;
+    field_f_ = field_x_;
+  }
+
+  // Symplectic Euler with the fields' force f_F(x, v) of the step's start: v' = v'_springs +
+  // h M⁻¹ f_F and x' = x + h v' = x'_springs + h² M⁻¹ f_F, on the free nodes.
+  void add_field_impulses(double dt, const Real* before, Real* after) {
+    for (int node : field_nodes_) {
+      const int i = soa_.new_id[static_cast<std::size_t>(node)];
+      for (int c = 0; c < 3; ++c) {
+        field_x_[3 * node + c] = before[kRecord * i + c];
+        field_v_[3 * node + c] = before[kRecord * i + 3 + c];
+        field_f_[3 * node + c] = 0.0;
+      }
+    }
+    for (const auto& field : fields_)
+      field->add_force(field_x_, field_v_, field_f_);
+    for (int node : field_nodes_) {
+      const int i = soa_.new_id[static_cast<std::size_t>(node)];
+      if (i >= soa_.num_free) continue;
+      for (int c = 0; c < 3; ++c) {
+        const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * field_f_[3 * node + c]);
+        after[kRecord * i + 3 + c] += dv;
+        after[kRecord * i + c] += static_cast<Real>(dt) * dv;
+      }
+    }
+    if (!field_f_.allFinite()) field_diverged_ = true;
+  }
+
   // Both record buffers from the layout's per-component arrays: the constrained nodes are read
   // from either, and the idle and far records never change.
   void pack() {
@@ -148,6 +207,10 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   detail::SoaLayout<Real> soa_;
   NodeGatherLayout<Real, W> gather_;
   detail::AlignedVector<Real> records_[2];  // x, v per node (kRecord), previous and next step
+  std::vector<std::shared_ptr<const ForceField>> fields_;
+  std::vector<int> field_nodes_;  ///< original node ids
+  Eigen::VectorXd field_x_, field_v_, field_f_;
+  bool field_diverged_ = false;
   std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;
@@ -158,11 +221,6 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
 FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
                                          const FastStepperOptions& options) {
-  // Its kernels know springs, anchors, gravity and loads only: dropping a force field silently
-  // would step another model than the one given.
-  if (!model.fields().empty())
-    throw ModelError("fast explicit stepper: its kernels do not step the model's force fields (" +
-                     model.field_names() + "); use Integrator");
   if (options.single_precision &&
       detail::preferred_lanes<float>(options.allow_avx512, model.network().num_springs(),
                                      model.num_nodes()) == 16)

@@ -68,6 +68,7 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
       SweepPoint pt;
       pt.variant = v.name;
       pt.integrator = massspring::to_string(integrator);
+      pt.stepper = t.stepper;
       pt.resolution = resolution;
       pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
       pt.nodes = v.nodes;
@@ -126,6 +127,7 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
     list.push_back(
         {{"variant", p.variant},
          {"integrator", p.integrator},
+         {"stepper", p.stepper},
          {"resolution", p.resolution},
          {"surface_vertices", p.surface_vertices},
          {"nodes", p.nodes},
@@ -153,8 +155,9 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
 
 std::string sweep_table(const std::vector<SweepPoint>& points) {
   std::ostringstream out;
-  out << "| variant | integrator | resolution | surface vertices | nodes | springs | rel L2 | "
-         "force err | FEM own err (L2 / force) | stable dt s | steps/s | realtime factor | "
+  out << "| variant | integrator (stepper) | resolution | surface vertices | nodes | springs | "
+         "rel L2 | force err | FEM own err (L2 / force) | stable dt s | steps/s | realtime factor "
+         "| "
          "ms/60 Hz frame |\n"
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char row[512];
@@ -169,14 +172,15 @@ std::string sweep_table(const std::vector<SweepPoint>& points) {
   };
   bool any_flag = false;
   for (const auto& p : points) {
-    std::snprintf(
-        row, sizeof row,
-        "| %s | %s | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | %.3g | %.3f |\n",
-        p.variant.c_str(), p.integrator.c_str(), p.resolution, p.surface_vertices, p.nodes,
-        p.springs, p.rel_l2_error, flag(p, "rel_l2_error"), p.reaction_force_rel_error,
-        flag(p, "reaction_force_rel_error"), number(p.fem_estimated_rel_l2_error).c_str(),
-        number(p.fem_estimated_force_rel_error).c_str(), p.stable_dt_s, p.steps_per_second,
-        p.realtime_factor, p.ms_per_60hz_frame);
+    std::snprintf(row, sizeof row,
+                  "| %s | %s (%s) | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | "
+                  "%.3g | %.3f |\n",
+                  p.variant.c_str(), p.integrator.c_str(), p.stepper.c_str(), p.resolution,
+                  p.surface_vertices, p.nodes, p.springs, p.rel_l2_error, flag(p, "rel_l2_error"),
+                  p.reaction_force_rel_error, flag(p, "reaction_force_rel_error"),
+                  number(p.fem_estimated_rel_l2_error).c_str(),
+                  number(p.fem_estimated_force_rel_error).c_str(), p.stable_dt_s,
+                  p.steps_per_second, p.realtime_factor, p.ms_per_60hz_frame);
     out << row;
     any_flag = any_flag || !p.not_resolved_by_reference.empty();
   }

@@ -13,7 +13,6 @@
 #include "msfem/cases/surface_simplification.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
 #include "msfem/massspring/errors.hpp"
-#include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/modal_damping.hpp"
 #include "msfem/massspring/stability.hpp"
@@ -324,82 +323,6 @@ StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::Ve
   else if (model.contact())
     solution.tool_force = ms::contact_reaction_force(model, r.x);
   return solution;
-}
-
-Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
-                    const Eigen::VectorXd& equilibrium, bool measure_settling) {
-  const ms::MassSpringModel& model = *variant.model;
-  const ms::IntegratorKind kind = timing.integrator;
-  Timing t;
-  t.integrator = ms::to_string(kind);
-  const ms::State start = ms::initial_state(model);
-  t.predicted_stable_dt_s = ms::predicted_stable_dt(model, kind, start.x);
-  if (kind == ms::IntegratorKind::implicit_euler || !std::isfinite(t.predicted_stable_dt_s)) {
-    // Unconditionally stable: report the step a haptic loop would use (1 kHz).
-    t.stable_dt_s = 1e-3;
-  } else {
-    const double guess = t.predicted_stable_dt_s;
-    t.stable_dt_s = ms::measure_stable_dt(model, kind, 0.25 * guess, 4.0 * guess, 400, 0.02);
-  }
-  t.dt_s = timing.dt_s > 0 ? timing.dt_s : 0.5 * t.stable_dt_s;
-
-  // The real-time path: the fast stepper for symplectic Euler (the prescribed patch is a support
-  // it honours); the generic integrator otherwise, and for volume preservation and the contact
-  // tool, which the fast kernels do not have.
-  const bool fast = kind == ms::IntegratorKind::symplectic_euler && model.fields().empty();
-  std::unique_ptr<ms::FastExplicitStepper> stepper;
-  ms::Integrator integrator(kind);
-  ms::State state = start;
-  if (fast) {
-    stepper = std::make_unique<ms::FastExplicitStepper>(model);
-    stepper->set_state(start);
-  }
-  auto advance = [&](int count) {
-    if (fast) {
-      stepper->step(t.dt_s, count);
-    } else {
-      for (int i = 0; i < count; ++i)
-        integrator.step(model, state, t.dt_s);
-    }
-  };
-  auto current = [&]() { return fast ? stepper->state() : state; };
-
-  // Settling, from rest with the load applied: checked every `stride` steps.
-  const Eigen::VectorXd x_rest = start.x;
-  const double travel = (equilibrium - x_rest).norm();
-  const int stride = 20;
-  const double wall_limit_s = 20.0;
-  const auto settle_start = Clock::now();
-  while (measure_settling && seconds_since(settle_start) < wall_limit_s) {
-    advance(stride);
-    const ms::State s = current();
-    if (!s.x.allFinite())
-      throw ms::DivergenceError("variant " + variant.name + " diverged while settling at dt " +
-                                    std::to_string(t.dt_s) + " s (stable dt " +
-                                    std::to_string(t.stable_dt_s) + " s)",
-                                t.dt_s, t.stable_dt_s);
-    if ((s.x - equilibrium).norm() <= 0.01 * travel) {
-      t.settled = true;
-      break;
-    }
-  }
-  t.settle_time_s = measure_settling ? seconds_since(settle_start) : 0.0;
-
-  // Speed: median of batches after a warm-up.
-  const int batches = 5;
-  const int per_batch = std::max(1, timing.steps / batches);
-  advance(std::max(1, per_batch / 4));
-  std::vector<double> rates;
-  for (int b = 0; b < batches; ++b) {
-    const auto batch_start = Clock::now();
-    advance(per_batch);
-    rates.push_back(per_batch / std::max(seconds_since(batch_start), 1e-9));
-  }
-  std::sort(rates.begin(), rates.end());
-  t.steps_per_second = rates[rates.size() / 2];
-  t.realtime_factor = t.stable_dt_s * t.steps_per_second;
-  t.ms_per_60hz_frame = 1000.0 * (1.0 / 60.0) / t.dt_s / t.steps_per_second;
-  return t;
 }
 
 }  // namespace msfem::compare

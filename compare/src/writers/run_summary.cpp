@@ -219,6 +219,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"patch_displacement_rel_error", json_or_null(first.patch_displacement_rel_error)},
       {"not_resolved_by_reference", unresolved_metrics(run, first, 0)},
       {"integrator", v.timing.integrator},
+      {"stepper", v.timing.stepper},
       {"dt_s", v.timing.dt_s},
       {"steps_per_second", v.timing.steps_per_second},
       {"stable_dt_s", v.timing.stable_dt_s},

@@ -17,8 +17,11 @@ struct FastStepperOptions {
 /// The real-time explicit stepper: symplectic Euler, which with velocities read at half steps is
 /// the central-difference (leapfrog) scheme of the pancreas paper,
 ///   v ← v + h M⁻¹ f(x, v),   x ← x + h v,
-/// on the model's springs, dampers, node damping, gravity, external forces and supports (tool
-/// contact is not applied here; use Integrator for that). The model must outlive the stepper.
+/// on the model's springs, dampers, node damping, gravity, external forces and supports, and its
+/// force fields (the tool's contact, volume preservation): each step adds a field's force, taken
+/// from the step's start like the springs', to the field's free nodes after the spring kernels. A
+/// field on a few nodes costs a step little; one on every node (volume preservation) runs on the
+/// calling thread. The model must outlive the stepper.
 ///
 /// Layout: nodes renumbered by reverse Cuthill-McKee with the constrained ones last (never
 /// updated); x and v of a node packed in one record. Each step is node-centric: every free node

@@ -65,8 +65,9 @@ class ForceModel {
 /// (copies of the model share them); a changed field is a new one put in its place.
 class ForceField : public ForceModel {
  public:
-  /// The nodes whose forces this field sets (the static solver's node relaxation leaves them to
-  /// Newton, unless it knows the field).
+  /// The nodes whose forces this field sets, and the only ones whose x and v add_force reads (the
+  /// static solver's node relaxation leaves them to Newton, unless it knows the field; the fast
+  /// explicit stepper gathers x and v at these nodes only).
   virtual const std::vector<int>& nodes() const = 0;
   /// Names of the coefficient groups a fit may scale, each one factor on a set of stiffnesses
   /// (volume preservation: "volume"); none by default.

@@ -23,7 +23,8 @@ struct SweepSettings {
 
 struct SweepPoint {
   std::string variant, integrator;
-  int resolution = 0;  ///< level or vertex target, as given
+  std::string stepper;  ///< the code timed (Timing::stepper)
+  int resolution = 0;   ///< level or vertex target, as given
   int surface_vertices = 0;
   int nodes = 0, springs = 0;
   double rel_l2_error = 0.0, reaction_force_rel_error = 0.0;

@@ -86,7 +86,10 @@ StaticSolution solve_variant_static(const BuiltVariant& variant,
                                     const Eigen::VectorXd& start = Eigen::VectorXd());
 
 struct Timing {
-  std::string integrator;         ///< the timed integrator's name; empty when not timed
+  std::string integrator;  ///< the timed integrator's name; empty when not timed
+  /// The code timed: fast_explicit (FastExplicitStepper), fast_implicit (FastImplicitStepper)
+  /// or generic (Integrator: explicit Euler, RK4, implicit Euler with a force field).
+  std::string stepper;
   double dt_s = 0.0;              ///< step used for steps/s and settling
   double steps_per_second = 0.0;  ///< median over batches after warm-up
   double stable_dt_s = 0.0;       ///< largest bounded dt, by bisection

@@ -1,0 +1,134 @@
+// How fast a variant runs: the case's integrator on the code a simulator would run for it (the
+// fast kernels where they cover the integrator and the model), timed from rest under the load.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "msfem/compare/pipeline/progress.hpp"
+#include "msfem/compare/pipeline/variant_run.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_implicit_stepper.hpp"
+#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/stability.hpp"
+
+namespace msfem::compare {
+namespace {
+
+namespace ms = msfem::massspring;
+
+// The stepper timed: FastExplicitStepper for symplectic Euler and central difference (its
+// symplectic Euler with velocities read at half steps is the leapfrog form of central difference:
+// one force evaluation per step, the same stable step), with the model's force fields (the tool's
+// contact, volume preservation); FastImplicitStepper for implicit Euler (with the haptic CG
+// settings msfem bench times) on a model without fields; the generic Integrator for explicit
+// Euler, RK4, and implicit Euler with a field, which the fast kernels do not have.
+class TimedStepper {
+ public:
+  TimedStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, const ms::State& start)
+      : model_(model), integrator_(kind), state_(start) {
+    if (kind == ms::IntegratorKind::symplectic_euler ||
+        kind == ms::IntegratorKind::central_difference) {
+      explicit_ = std::make_unique<ms::FastExplicitStepper>(model);
+      explicit_->set_state(start);
+    } else if (kind == ms::IntegratorKind::implicit_euler && model.fields().empty()) {
+      implicit_ = std::make_unique<ms::FastImplicitStepper>(model);
+      implicit_->set_state(start);
+    }
+  }
+
+  void advance(double dt, int count) {
+    if (explicit_) return explicit_->step(dt, count);
+    for (int i = 0; i < count; ++i)
+      if (implicit_)
+        implicit_->step(dt);
+      else
+        integrator_.step(model_, state_, dt);
+  }
+
+  ms::State state() const {
+    return explicit_ ? explicit_->state() : implicit_ ? implicit_->state() : state_;
+  }
+
+  const char* name() const {
+    return explicit_ ? "fast_explicit" : implicit_ ? "fast_implicit" : "generic";
+  }
+
+ private:
+  const ms::MassSpringModel& model_;
+  ms::Integrator integrator_;
+  ms::State state_;
+  std::unique_ptr<ms::FastExplicitStepper> explicit_;
+  std::unique_ptr<ms::FastImplicitStepper> implicit_;
+};
+
+// The largest step the integrator keeps bounded, by bisection about the predicted one; for an
+// unconditionally stable one the step a haptic loop uses (1 kHz).
+void stable_step(Timing& t, const ms::MassSpringModel& model, ms::IntegratorKind kind,
+                 const ms::State& start) {
+  t.predicted_stable_dt_s = ms::predicted_stable_dt(model, kind, start.x);
+  if (kind == ms::IntegratorKind::implicit_euler || !std::isfinite(t.predicted_stable_dt_s)) {
+    t.stable_dt_s = 1e-3;
+  } else {
+    const double guess = t.predicted_stable_dt_s;
+    t.stable_dt_s = ms::measure_stable_dt(model, kind, 0.25 * guess, 4.0 * guess, 400, 0.02);
+  }
+}
+
+// Wall time from rest, with the load applied, to within 1 % of the static equilibrium's travel.
+void settle(Timing& t, TimedStepper& stepper, const BuiltVariant& variant,
+            const Eigen::VectorXd& x_rest, const Eigen::VectorXd& equilibrium) {
+  const double travel = (equilibrium - x_rest).norm();
+  const int stride = 20;
+  const double wall_limit_s = 20.0;
+  const auto start = Clock::now();
+  while (seconds_since(start) < wall_limit_s) {
+    stepper.advance(t.dt_s, stride);
+    const ms::State s = stepper.state();
+    if (!s.x.allFinite())
+      throw ms::DivergenceError("variant " + variant.name + " diverged while settling at dt " +
+                                    std::to_string(t.dt_s) + " s (stable dt " +
+                                    std::to_string(t.stable_dt_s) + " s)",
+                                t.dt_s, t.stable_dt_s);
+    if ((s.x - equilibrium).norm() <= 0.01 * travel) {
+      t.settled = true;
+      break;
+    }
+  }
+  t.settle_time_s = seconds_since(start);
+}
+
+}  // namespace
+
+Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
+                    const Eigen::VectorXd& equilibrium, bool measure_settling) {
+  const ms::MassSpringModel& model = *variant.model;
+  const ms::IntegratorKind kind = timing.integrator;
+  Timing t;
+  t.integrator = ms::to_string(kind);
+  const ms::State start = ms::initial_state(model);
+  stable_step(t, model, kind, start);
+  t.dt_s = timing.dt_s > 0 ? timing.dt_s : 0.5 * t.stable_dt_s;
+  TimedStepper stepper(model, kind, start);
+  t.stepper = stepper.name();
+  if (measure_settling) settle(t, stepper, variant, start.x, equilibrium);
+
+  // Speed: median of batches after a warm-up.
+  const int batches = 5;
+  const int per_batch = std::max(1, timing.steps / batches);
+  stepper.advance(t.dt_s, std::max(1, per_batch / 4));
+  std::vector<double> rates;
+  for (int b = 0; b < batches; ++b) {
+    const auto batch_start = Clock::now();
+    stepper.advance(t.dt_s, per_batch);
+    rates.push_back(per_batch / std::max(seconds_since(batch_start), 1e-9));
+  }
+  std::sort(rates.begin(), rates.end());
+  t.steps_per_second = rates[rates.size() / 2];
+  t.realtime_factor = t.stable_dt_s * t.steps_per_second;
+  t.ms_per_60hz_frame = 1000.0 * (1.0 / 60.0) / t.dt_s / t.steps_per_second;
+  return t;
+}
+
+}  // namespace msfem::compare
