@@ -7,7 +7,8 @@ packages=(
   libeigen3-dev          # massspring's only dependency: dense/sparse linear algebra
   libnanoflann-dev       # k-d tree for the skeleton's 4-nearest control points (header-only)
   libdeal.ii-dev         # FEM reference; brings PETSc (hypre, MUMPS), MPI, HDF5, Gmsh, CGAL, p4est
-  libcgal-dev            # surface validation (self-intersections) and simplification
+  libcgal-dev            # surface validation (self-intersections), simplification, Mesh_3 extraction
+  libnifti2-dev          # msfem surface-from-image: NIfTI-1/2 reader (niftilib, the reference implementation)
   libhdf5-openmpi-dev    # fields.h5 output (the HDF5 deal.II links, so one HDF5 per process)
   nlohmann-json3-dev     # summary.json and every --json output
   libnlopt-cxx-dev       # msfem calibrate: derivative-free optimiser (BOBYQA) for spring coefficients

@@ -17,6 +17,7 @@
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/massspring/integrators.hpp"
 
@@ -35,8 +36,10 @@ Patterns::List point_pattern() {
 void declare_geometry(ParameterHandler& prm) {
   prm.enter_subsection("geometry");
   prm.declare_entry("source", "icosphere:3:0.05", Patterns::Anything(),
-                    "Closed surface: a file (.obj .stl .off .ply; relative to the case file) or "
-                    "a generator, icosphere:LEVEL[:RADIUS_M] or ellipsoid:LEVEL:A:B:C (metres).");
+                    "Closed surface: a file (.obj .stl .off .ply; relative to the case file), "
+                    "a generator, icosphere:LEVEL[:RADIUS_M] or ellipsoid:LEVEL:A:B:C (metres), "
+                    "or an organ of a NIfTI image, image:FILE:label=N or "
+                    "image:FILE:threshold=LO[:HI] (FILE relative to the case file; unit unused).");
   prm.declare_entry("unit", "m", Patterns::Selection(selection_of<LengthUnit>()),
                     "Unit of the surface file's coordinates; msfem works in metres.");
   prm.declare_entry("simplify to vertices", "0", Patterns::Integer(0),
@@ -534,7 +537,13 @@ CaseParameters read_case(const std::filesystem::path& file,
   c.file = file;
   c.name = file.stem().string();
   // A relative surface path is relative to the case file, so cases run from any folder.
-  if (!is_surface_generator(c.geometry.source)) {
+  if (is_image_source(c.geometry.source)) {
+    try {
+      c.geometry.source = image_source_relative_to(c.geometry.source, file.parent_path());
+    } catch (const InputError& e) {
+      throw InputError(file.string() + ": " + e.what());
+    }
+  } else if (!is_surface_generator(c.geometry.source)) {
     const std::filesystem::path p(c.geometry.source);
     if (p.is_relative()) c.geometry.source = (file.parent_path() / p).lexically_normal().string();
   }

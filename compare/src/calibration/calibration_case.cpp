@@ -6,6 +6,7 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/fem_references.hpp"
@@ -291,9 +292,14 @@ void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& para
     c.notes.push_back(
         "damping: spring dampers cannot give the tool-response mode the target ratio");
   }
-  if (!cases::is_surface_generator(parameters.geometry.source))
+  const std::string& source = parameters.geometry.source;
+  if (cases::is_image_source(source))
     c.calibrated_overrides.push_back(
-        "geometry/source=" + std::filesystem::absolute(parameters.geometry.source).string());
+        "geometry/source=" +
+        cases::image_source_relative_to(source, std::filesystem::current_path()));
+  else if (!cases::is_surface_generator(source))
+    c.calibrated_overrides.push_back("geometry/source=" +
+                                     std::filesystem::absolute(source).string());
   c.lumped_mass_kg = built.model->network().masses.sum();
   c.fem_mass_kg = parameters.material.density_kg_per_m3 * fem_reference::volume(c.mesh);
 }

@@ -54,6 +54,11 @@ const std::vector<CommandEntry>& commands() {
       {"simplify", simplify_command,
        "simplify IN OUT --vertices N [--unit m|cm|mm] [--smooth ITERATIONS] [--binary]\n"
        "      edge-collapse to exactly N vertices (then Taubin smoothing), written in IN's unit"},
+      {"surface-from-image", surface_from_image_command,
+       "surface-from-image IMAGE OUT (--label N | --threshold LO[:HI]) [--vertices N]\n"
+       "          [--smooth K] [--unit m|cm|mm]\n"
+       "      an organ of a NIfTI image (.nii, .nii.gz) as a closed surface in world coordinates:\n"
+       "      largest component, cavities filled, CGAL Mesh_3 extraction, then simplification"},
       {"bench", bench_command,
        "bench massspring [--json] [--mesh-dir DIR] [--threads N] [--samples N] [--seconds S]\n"
        "          [--float] [--no-10x]\n"

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/cases/surface_refinement.hpp"
@@ -35,10 +36,20 @@ void warn_if_not_organ_sized(const cases::CaseParameters& p, const cases::Surfac
   std::cerr << "msfem: warning: " << p.file.string() << ": " << text << "\n";
 }
 
+// The organ of a NIfTI image, as extracted; the case's own simplification and smoothing follow.
+cases::Surface surface_of_image(const std::string& source, std::vector<std::string>& notes) {
+  const cases::ImageSource image = cases::parse_image_source(source);
+  cases::ImageSurface extracted = cases::surface_from_image(image.file, {image.selection, 0, 0});
+  for (const auto& note : extracted.notes)
+    notes.push_back(note);
+  notes.push_back("extracted " + std::to_string(extracted.surface.num_vertices()) +
+                  " vertices from " + image.selection.describe() + " of " + image.file.string());
+  return std::move(extracted.surface);
+}
+
 cases::Surface load_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
   const auto& g = p.geometry;
-  cases::Surface s = cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
-                                                           : cases::read_surface(g.source, g.unit);
+  cases::Surface s = source_surface(p, notes);
   if (g.simplify_to_vertices > s.num_vertices())
     throw cases::InputError(p.file.string() + ": geometry/simplify to vertices = " +
                             std::to_string(g.simplify_to_vertices) + " is more than the " +
@@ -274,6 +285,13 @@ double volume_change(const cases::Surface& surface, const Eigen::MatrixX3d& disp
 ToolPlacement at_depth(ToolPlacement tool, double depth) {
   tool.depth = depth;
   return tool;
+}
+
+cases::Surface source_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
+  const auto& g = p.geometry;
+  return cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
+         : cases::is_image_source(g.source)    ? surface_of_image(g.source, notes)
+                                               : cases::read_surface(g.source, g.unit);
 }
 
 Problem make_problem(const cases::CaseParameters& parameters) {

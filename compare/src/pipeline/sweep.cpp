@@ -20,8 +20,8 @@ namespace {
 
 std::vector<int> default_resolutions(const cases::CaseParameters& p) {
   if (cases::is_surface_generator(p.geometry.source)) return {2, 3, 4, 5};
-  const int available =
-      static_cast<int>(cases::read_surface(p.geometry.source, p.geometry.unit).num_vertices());
+  std::vector<std::string> notes;
+  const int available = static_cast<int>(source_surface(p, notes).num_vertices());
   std::vector<int> r;
   for (int n : {2000, 5000, 9177, 20000, 40000})
     if (n < 0.95 * available) r.push_back(n);  // not a near-copy of the surface as read

@@ -13,11 +13,12 @@ using Arguments = std::vector<std::string>;
 
 int mesh_info_command(const Arguments& args);  // msfem mesh-info FILE [--unit mm]
 int simplify_command(const Arguments& args);   // msfem simplify IN OUT --vertices N [--smooth K]
-int run_command(const Arguments& args);        // msfem run CASE.prm [--out DIR] [--set K=V]...
-int params_command(const Arguments& args);     // msfem params
-int sweep_command(const Arguments& args);      // msfem sweep CASE.prm [--resolutions ...]
-int bench_command(const Arguments& args);      // msfem bench massspring|fem [--json]
-int verify_command(const Arguments& args);     // msfem verify [--json]
+int surface_from_image_command(const Arguments& args);  // msfem surface-from-image IMAGE OUT
+int run_command(const Arguments& args);      // msfem run CASE.prm [--out DIR] [--set K=V]...
+int params_command(const Arguments& args);   // msfem params
+int sweep_command(const Arguments& args);    // msfem sweep CASE.prm [--resolutions ...]
+int bench_command(const Arguments& args);    // msfem bench massspring|fem [--json]
+int verify_command(const Arguments& args);   // msfem verify [--json]
 int regress_command(const Arguments& args);  // msfem regress [--baselines DIR] [CASE...] [--update]
 int calibrate_command(const Arguments& args);  // msfem calibrate CASE.prm [--variant V] [--fit G]
 

@@ -48,6 +48,11 @@ struct Problem {
   std::optional<LocalRefinement> local_refinement;
 };
 
+/// The case's surface as its source gives it (a generator, an image's organ, or a file), before
+/// the case's simplification, smoothing and checks; `notes` gets what extraction did.
+cases::Surface source_surface(const cases::CaseParameters& parameters,
+                              std::vector<std::string>& notes);
+
 /// Loads and checks the case's surface (generate or read, simplify, smooth, orient) and places its
 /// supports and tools. Throws cases::InputError naming the case file for a surface with defects, a
 /// fixed region or tool that catches no surface node, or a tool deeper than the model.
