@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -39,6 +40,41 @@ TEST(CliSweep, AResolutionThatCannotBeRunIsReportedAndTheOthersAreStillSwept) {
   EXPECT_LT(report.find("## Answer"), report.find("## Every configuration")) << report;
   EXPECT_NE(report.find("| cheapest with rel L2 <= 10 | "), std::string::npos) << report;
   EXPECT_EQ(report.find("| cheapest with rel L2 <= 10 | none"), std::string::npos) << report;
+}
+
+// Volume preservation as a sweep dimension: the variants with volume elements (three_tier and
+// tet_edges) are swept with and without them, on the same FEM reference; the others once. At
+// nu = 0.45 the volume elements stiffen the model (at 0.25 the springs alone have its bulk
+// modulus and the elements none), so its error differs.
+TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "sweep";
+  const auto r =
+      run_msfem("sweep " + small_case +
+                " --quiet --resolutions 1 --integrators symplectic_euler "
+                "--volume-preservation both --set \"material/poisson ratio=0.45\" --out " +
+                out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
+  std::map<std::string, std::vector<double>> errors;  // variant -> rel L2 without, with
+  for (const auto& p : j["points"]) {
+    EXPECT_EQ(p["stepper"], "fast_explicit");
+    errors[p["variant"].get<std::string>()].push_back(p["rel_l2_error"].get<double>());
+    if (p["volume_preservation"].get<bool>())
+      EXPECT_TRUE(p["variant"] == "three_tier" || p["variant"] == "tet_edges") << p.dump();
+  }
+  ASSERT_EQ(errors.size(), 4u);
+  for (const char* volumetric : {"three_tier", "tet_edges"}) {
+    ASSERT_EQ(errors[volumetric].size(), 2u) << volumetric;
+    EXPECT_GT(std::abs(errors[volumetric][0] - errors[volumetric][1]), 1e-6) << volumetric;
+  }
+  EXPECT_EQ(errors["single_layer"].size(), 1u);
+  EXPECT_NE(read_text(out / "report.md").find("three_tier+volume"), std::string::npos);
+  const auto bad = run_msfem("sweep " + small_case + " --quiet --volume-preservation maybe --out " +
+                             (tmp / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--volume-preservation"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
 }
 
 TEST(CliSweep, AMaximumErrorThatIsNotAPositiveNumberIsRefusedBeforeAnySolve) {

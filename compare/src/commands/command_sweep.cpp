@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
@@ -62,8 +63,8 @@ std::filesystem::path pareto_plot(const std::filesystem::path& file, const std::
                                   const std::vector<SweepPoint>& points) {
   std::vector<ParetoPoint> pareto_points;
   for (const auto& p : points)
-    pareto_points.push_back({p.variant + " " + p.integrator + " @" + std::to_string(p.resolution),
-                             p.realtime_factor, p.rel_l2_error, p.variant, p.integrator,
+    pareto_points.push_back({p.model() + " " + p.integrator + " @" + std::to_string(p.resolution),
+                             p.realtime_factor, p.rel_l2_error, p.model(), p.integrator,
                              keeps_real_time(p, 1000.0)});
   return pareto(file, "Relative error against real-time factor: " + name, pareto_points);
 }
@@ -71,18 +72,25 @@ std::filesystem::path pareto_plot(const std::filesystem::path& file, const std::
 }  // namespace
 
 int sweep_command(const Arguments& args) {
-  const Options opt(args, {"quiet", "json"},
-                    {"out", "set", "resolutions", "integrators", "max-error"});
+  const Options opt(
+      args, {"quiet", "json"},
+      {"out", "set", "resolutions", "integrators", "max-error", "volume-preservation"});
   if (opt.positional().size() != 1)
     throw std::invalid_argument(
         "usage: msfem sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--max-error E] "
-        "[--out DIR]");
+        "[--volume-preservation off|on|both] [--out DIR]");
   std::optional<double> max_error;
   if (const auto e = opt.value("max-error")) max_error = positive_number("max-error", *e);
   const cases::CaseParameters parameters = cases::read_case(opt.positional()[0], opt.values("set"));
   SweepSettings settings;
   settings.quiet = opt.flag("quiet");
   if (const auto r = opt.value("resolutions")) settings.resolutions = integers("resolutions", *r);
+  if (const auto v = opt.value("volume-preservation")) {
+    if (*v != "off" && *v != "on" && *v != "both")
+      throw cases::InputError("option --volume-preservation: '" + *v + "' is not off, on or both");
+    settings.volume_preservation =
+        *v == "both" ? std::vector<bool>{false, true} : std::vector<bool>{*v == "on"};
+  }
   if (const auto i = opt.value("integrators")) {
     settings.integrators.clear();
     for (const auto& name : split(*i))

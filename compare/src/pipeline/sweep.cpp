@@ -42,12 +42,16 @@ cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
   return p;
 }
 
-// One resolution's points: every variant with every integrator.
+// One resolution's points with volume preservation as `volume`: every variant that has the
+// setting's model with every integrator (a variant without volume elements is left out of the
+// volume-preserving pass: it would repeat the other's points). The FEM comes from the cache after
+// the first pass.
 std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
-                                         const SweepSettings& settings,
+                                         const SweepSettings& settings, bool volume,
                                          const std::filesystem::path& fem_cache_directory) {
   std::vector<SweepPoint> points;
-  const cases::CaseParameters p = at_resolution(parameters, resolution);
+  cases::CaseParameters p = at_resolution(parameters, resolution);
+  p.mass_spring.volume_preservation = volume;
   RunSettings run_settings;
   run_settings.quiet = true;
   run_settings.force_depth_curve = false;
@@ -57,6 +61,8 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
   const CaseRun run = run_case(p, run_settings);
   const LoadReference& load = run.loads.front();
   for (const auto& v : run.variants) {
+    const bool has_volume = v.parameters.contains("volume_preservation");
+    if (volume && !has_volume) continue;
     const BuiltVariant built = build_variant(v.kind, run.problem, run.mesh, load.tool);
     const ToolLoadVariant& at_load = v.loads.front();
     const Eigen::VectorXd& equilibrium = at_load.equilibrium;  // run_case's, from rest as here
@@ -69,6 +75,7 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
       pt.variant = v.name;
       pt.integrator = massspring::to_string(integrator);
       pt.stepper = t.stepper;
+      pt.volume_preservation = has_volume;
       pt.resolution = resolution;
       pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
       pt.nodes = v.nodes;
@@ -95,6 +102,10 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
                       const std::filesystem::path& fem_cache_directory) {
   const std::vector<int> resolutions =
       settings.resolutions.empty() ? default_resolutions(parameters) : settings.resolutions;
+  const std::vector<bool> volume_settings =
+      settings.volume_preservation.empty()
+          ? std::vector<bool>{parameters.mass_spring.volume_preservation}
+          : settings.volume_preservation;
   const Progress progress(settings.quiet);
   const auto start = std::chrono::steady_clock::now();
   SweepResult result;
@@ -103,8 +114,12 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   for (std::size_t r = 0; r < resolutions.size(); ++r) {
     try {
       // All of a resolution's points or none of them.
-      const std::vector<SweepPoint> more =
-          sweep_resolution(parameters, resolutions[r], settings, fem_cache_directory);
+      std::vector<SweepPoint> more;
+      for (const bool volume : volume_settings) {
+        const std::vector<SweepPoint> pass =
+            sweep_resolution(parameters, resolutions[r], settings, volume, fem_cache_directory);
+        more.insert(more.end(), pass.begin(), pass.end());
+      }
       points.insert(points.end(), more.begin(), more.end());
     } catch (const std::exception& e) {
       if (!first_failure) first_failure = std::current_exception();
@@ -126,6 +141,7 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
   for (const auto& p : result.points)
     list.push_back(
         {{"variant", p.variant},
+         {"volume_preservation", p.volume_preservation},
          {"integrator", p.integrator},
          {"stepper", p.stepper},
          {"resolution", p.resolution},
@@ -175,7 +191,7 @@ std::string sweep_table(const std::vector<SweepPoint>& points) {
     std::snprintf(row, sizeof row,
                   "| %s | %s (%s) | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | "
                   "%.3g | %.3f |\n",
-                  p.variant.c_str(), p.integrator.c_str(), p.stepper.c_str(), p.resolution,
+                  p.model().c_str(), p.integrator.c_str(), p.stepper.c_str(), p.resolution,
                   p.surface_vertices, p.nodes, p.springs, p.rel_l2_error, flag(p, "rel_l2_error"),
                   p.reaction_force_rel_error, flag(p, "reaction_force_rel_error"),
                   number(p.fem_estimated_rel_l2_error).c_str(),
@@ -193,8 +209,8 @@ std::vector<VariantConvergence> convergence_by_variant(const std::vector<SweepPo
   std::vector<VariantConvergence> result;
   for (const auto& p : points) {
     auto it = std::find_if(result.begin(), result.end(),
-                           [&](const VariantConvergence& v) { return v.variant == p.variant; });
-    if (it == result.end()) it = result.insert(result.end(), {p.variant, {}, std::nullopt});
+                           [&](const VariantConvergence& v) { return v.variant == p.model(); });
+    if (it == result.end()) it = result.insert(result.end(), {p.model(), {}, std::nullopt});
     auto& at = it->error_at_vertices;
     if (std::none_of(at.begin(), at.end(),
                      [&](const auto& e) { return e.first == p.surface_vertices; }))
@@ -247,7 +263,7 @@ bool keeps_real_time(const SweepPoint& point, double rate_hz) {
 namespace {
 
 std::string configuration(const SweepPoint& p) {
-  return p.variant + ", " + p.integrator + ", resolution " + std::to_string(p.resolution) + " (" +
+  return p.model() + ", " + p.integrator + ", resolution " + std::to_string(p.resolution) + " (" +
          std::to_string(p.nodes) + " nodes)";
 }
 

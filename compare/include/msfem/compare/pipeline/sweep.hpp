@@ -18,13 +18,19 @@ struct SweepSettings {
   std::vector<massspring::IntegratorKind> integrators = {
       massspring::IntegratorKind::symplectic_euler, massspring::IntegratorKind::central_difference,
       massspring::IntegratorKind::rk4, massspring::IntegratorKind::implicit_euler};
+  /// Volume preservation off and/or on for the variants that have it (three_tier, tet_edges);
+  /// empty: as the case sets it.
+  std::vector<bool> volume_preservation;
   bool quiet = false;
 };
 
 struct SweepPoint {
   std::string variant, integrator;
-  std::string stepper;  ///< the code timed (Timing::stepper)
-  int resolution = 0;   ///< level or vertex target, as given
+  std::string stepper;               ///< the code timed (Timing::stepper)
+  bool volume_preservation = false;  ///< the variant's volume elements on
+  /// The variant as the report names it: with volume preservation, "variant+volume".
+  std::string model() const { return volume_preservation ? variant + "+volume" : variant; }
+  int resolution = 0;  ///< level or vertex target, as given
   int surface_vertices = 0;
   int nodes = 0, springs = 0;
   double rel_l2_error = 0.0, reaction_force_rel_error = 0.0;
