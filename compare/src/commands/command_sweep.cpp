@@ -69,6 +69,13 @@ std::filesystem::path pareto_plot(const std::filesystem::path& file, const std::
   return pareto(file, "Relative error against real-time factor: " + name, pareto_points);
 }
 
+// --volume-preservation off|on|both.
+std::vector<bool> volume_settings(const std::string& value) {
+  if (value != "off" && value != "on" && value != "both")
+    throw cases::InputError("option --volume-preservation: '" + value + "' is not off, on or both");
+  return value == "both" ? std::vector<bool>{false, true} : std::vector<bool>{value == "on"};
+}
+
 }  // namespace
 
 int sweep_command(const Arguments& args) {
@@ -85,12 +92,8 @@ int sweep_command(const Arguments& args) {
   SweepSettings settings;
   settings.quiet = opt.flag("quiet");
   if (const auto r = opt.value("resolutions")) settings.resolutions = integers("resolutions", *r);
-  if (const auto v = opt.value("volume-preservation")) {
-    if (*v != "off" && *v != "on" && *v != "both")
-      throw cases::InputError("option --volume-preservation: '" + *v + "' is not off, on or both");
-    settings.volume_preservation =
-        *v == "both" ? std::vector<bool>{false, true} : std::vector<bool>{*v == "on"};
-  }
+  if (const auto v = opt.value("volume-preservation"))
+    settings.volume_preservation = volume_settings(*v);
   if (const auto i = opt.value("integrators")) {
     settings.integrators.clear();
     for (const auto& name : split(*i))
