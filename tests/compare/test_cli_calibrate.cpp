@@ -54,7 +54,9 @@ TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
     for (const auto& note : j["notes"])
       warned =
           warned || note.get<std::string>().find("fewer than 3 surface nodes") != std::string::npos;
-    if (inside < 3) EXPECT_TRUE(warned) << inside << " nodes and no note";
+    if (inside < 3) {
+      EXPECT_TRUE(warned) << inside << " nodes and no note";
+    }
   }
   EXPECT_LT(j["after"]["objective"].get<double>(), j["before"]["objective"].get<double>());
   ASSERT_EQ(j["coefficients"].size(), 3u);
