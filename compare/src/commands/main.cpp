@@ -30,10 +30,10 @@ const std::vector<CommandEntry>& commands() {
        "      the FEM even if <output directory>/.fem-cache holds it)"},
       {"sweep", sweep_command,
        "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
-       "          [--max-error E] [--quiet] [--json]\n"
-       "      variants x resolutions x integrators: sweep.json, report.md opening with the least-\n"
-       "      error configuration for a 60 Hz and a 1 kHz loop in real time (and the cheapest\n"
-       "      within rel L2 E), table and Pareto plot"},
+       "          [--max-error E] [--volume-preservation off|on|both] [--quiet] [--json]\n"
+       "      variants x resolutions x integrators (x volume preservation): sweep.json, report.md\n"
+       "      opening with the least-error configuration for a 60 Hz and a 1 kHz loop in real\n"
+       "      time (and the cheapest within rel L2 E), table and Pareto plot"},
       {"regress", regress_command,
        "regress [--baselines DIR] [CASE.prm...] [--update] [--set K=V]... [--quiet]\n"
        "      compare runs with committed baselines; exit 1 on a worse metric or field, a missing\n"
@@ -54,6 +54,14 @@ const std::vector<CommandEntry>& commands() {
       {"simplify", simplify_command,
        "simplify IN OUT --vertices N [--unit m|cm|mm] [--smooth ITERATIONS] [--binary]\n"
        "      edge-collapse to exactly N vertices (then Taubin smoothing), written in IN's unit"},
+      {"repair", repair_command,
+       "repair IN OUT [--unit m|cm|mm] [--all-components] [--wrap] [--alpha A] [--offset D]\n"
+       "          [--binary]\n"
+       "      a broken mesh as a closed, manifold, outward surface that mesh-info accepts: merge,\n"
+       "      drop degenerate and duplicate triangles, orient, stitch, keep the largest piece\n"
+       "      (--all-components: every piece), and CGAL's alpha wrap where that is not enough\n"
+       "      (--wrap: always; alpha defaults to the mean edge length within [diagonal/200,\n"
+       "      diagonal/20], offset to alpha/30). Lengths and OUT are in IN's unit"},
       {"surface-from-image", surface_from_image_command,
        "surface-from-image IMAGE OUT (--label N | --threshold LO[:HI]) [--vertices N]\n"
        "          [--smooth K] [--unit m|cm|mm]\n"

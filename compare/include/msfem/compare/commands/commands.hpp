@@ -14,6 +14,7 @@ using Arguments = std::vector<std::string>;
 int mesh_info_command(const Arguments& args);  // msfem mesh-info FILE [--unit mm]
 int simplify_command(const Arguments& args);   // msfem simplify IN OUT --vertices N [--smooth K]
 int surface_from_image_command(const Arguments& args);  // msfem surface-from-image IMAGE OUT
+int repair_command(const Arguments& args);   // msfem repair IN OUT [--all-components] [--wrap]
 int run_command(const Arguments& args);      // msfem run CASE.prm [--out DIR] [--set K=V]...
 int params_command(const Arguments& args);   // msfem params
 int sweep_command(const Arguments& args);    // msfem sweep CASE.prm [--resolutions ...]
