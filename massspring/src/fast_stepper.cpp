@@ -160,12 +160,13 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
       const int i = soa_.new_id[static_cast<std::size_t>(node)];
       if (i >= soa_.num_free) continue;
       for (int c = 0; c < 3; ++c) {
-        const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * field_f_[3 * node + c]);
+        const double f = field_f_[3 * node + c];
+        if (!std::isfinite(f)) field_diverged_ = true;
+        const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * f);
         after[kRecord * i + 3 + c] += dv;
         after[kRecord * i + c] += static_cast<Real>(dt) * dv;
       }
     }
-    if (!field_f_.allFinite()) field_diverged_ = true;
   }
 
   // Both record buffers from the layout's per-component arrays: the constrained nodes are read

@@ -80,10 +80,7 @@ int repair_command(const Arguments& args) {
   options.offset = length_option(opt, "offset", metres);
   const std::string& in = opt.positional()[0];
   const std::string& out = opt.positional()[1];
-  std::error_code ignored;
-  if (std::filesystem::weakly_canonical(in, ignored) ==
-      std::filesystem::weakly_canonical(out, ignored))
-    throw std::invalid_argument("OUT '" + out + "' is the input file: repair writes a new file");
+  refuse_writing_over_input(in, out, "repair");
   cases::surface_format_for(out);  // an unknown OUT extension fails before the work
 
   const auto start = std::chrono::steady_clock::now();

@@ -21,10 +21,7 @@ int simplify_command(const Arguments& args) {
   if (smoothing < 0) throw std::invalid_argument("option --smooth must be >= 0");
   const std::string& in = opt.positional()[0];
   const std::string& out = opt.positional()[1];
-  std::error_code ignored;
-  if (std::filesystem::weakly_canonical(in, ignored) ==
-      std::filesystem::weakly_canonical(out, ignored))
-    throw std::invalid_argument("OUT '" + out + "' is the input file: simplify writes a new file");
+  refuse_writing_over_input(in, out, "simplify");
 
   cases::Surface surface = cases::read_surface(in, unit);
   const auto before = cases::orient_and_validate(surface, /*check_self_intersections=*/false);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <ctime>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>
@@ -18,6 +19,17 @@ inline std::string run_timestamp() {
   char text[32];
   std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
   return text;
+}
+
+/// Refuses an OUT that is IN itself (a command that rewrites a surface writes a new file; writing
+/// over its input would lose it on a failure), naming the command.
+inline void refuse_writing_over_input(const std::string& in, const std::string& out,
+                                      const std::string& command) {
+  std::error_code ignored;
+  if (std::filesystem::weakly_canonical(in, ignored) ==
+      std::filesystem::weakly_canonical(out, ignored))
+    throw std::invalid_argument("OUT '" + out + "' is the input file: " + command +
+                                " writes a new file");
 }
 
 /// Command-line options of one sub-command: `--flag`, `--key value` or `--key=value`, and
