@@ -16,6 +16,7 @@
 #include "case_file_text.hpp"
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/modulus_image.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
@@ -58,6 +59,16 @@ void declare_material(ParameterHandler& prm) {
   prm.declare_entry("poisson ratio", "0.45", Patterns::Double(-0.999, 0.4999),
                     "Poisson's ratio; a plain spring network is exact only at 0.25.");
   prm.declare_entry("density", "1040", Patterns::Double(0, 1e5), "Density in kg/m^3; in (0, 1e5].");
+  prm.declare_entry(
+      "youngs modulus image", "", Patterns::Anything(),
+      "A CT in Hounsfield units (.nii, .nii.gz; relative to the case file) giving E "
+      "per voxel through 'hu to youngs', interpolated trilinearly: the FEM takes E at "
+      "its quadrature points, each spring the series (harmonic) mean along it, each "
+      "volume element E at its centroid. 'youngs modulus' is then only the scale "
+      "the spring rules start from. Empty: E = 'youngs modulus' everywhere.");
+  prm.declare_entry("hu to youngs", default_hu_to_youngs, Patterns::Anything(),
+                    "HU:E points (E in Pa), HU increasing, linear between them and held beyond: "
+                    "fat -100 HU 3 kPa, pancreas 40 HU 3.5 kPa, liver 60 HU 6 kPa by default.");
   prm.leave_subsection();
 }
 
@@ -351,8 +362,10 @@ void extract_geometry(ParameterHandler& prm, CaseParameters& c) {
 void extract_material(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("material");
   c.material = {prm.get_double("youngs modulus"), prm.get_double("poisson ratio"),
-                prm.get_double("density")};
+                prm.get_double("density"), prm.get("youngs modulus image"),
+                prm.get("hu to youngs")};
   prm.leave_subsection();
+  parse_hu_to_youngs(c.material.hu_to_youngs, "material/hu to youngs");
   if (!(c.material.youngs_modulus_pa > 0)) throw InputError("material/youngs modulus must be > 0");
   if (!(c.material.density_kg_per_m3 > 0)) throw InputError("material/density must be > 0");
 }
@@ -547,6 +560,9 @@ CaseParameters read_case(const std::filesystem::path& file,
     const std::filesystem::path p(c.geometry.source);
     if (p.is_relative()) c.geometry.source = (file.parent_path() / p).lexically_normal().string();
   }
+  if (const std::filesystem::path image(c.material.youngs_modulus_image);
+      !image.empty() && image.is_relative())
+    c.material.youngs_modulus_image = (file.parent_path() / image).lexically_normal().string();
   return c;
 }
 

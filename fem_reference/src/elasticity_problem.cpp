@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -214,6 +215,8 @@ class CellAssembler {
   }
 
   const std::vector<long>& loaded_faces() const { return loaded_faces_; }
+  double youngs_modulus_min() const { return youngs_modulus_min_; }
+  double youngs_modulus_max() const { return youngs_modulus_max_; }
 
  private:
   double youngs_modulus_at(const Eigen::Vector3d& x) const {
@@ -224,6 +227,8 @@ class CellAssembler {
       throw std::invalid_argument("Young's modulus field must be positive, got " +
                                   std::to_string(E) + " Pa at (" + std::to_string(x.x()) + ", " +
                                   std::to_string(x.y()) + ", " + std::to_string(x.z()) + ")");
+    youngs_modulus_min_ = std::min(youngs_modulus_min_, E);
+    youngs_modulus_max_ = std::max(youngs_modulus_max_, E);
     return E;
   }
 
@@ -261,6 +266,9 @@ class CellAssembler {
   std::vector<SymmetricTensor<2, dim>> symmetric_gradients_;
   std::vector<double> divergences_;
   std::vector<long> loaded_faces_;  ///< boundary faces each traction was applied to
+  // What the field gave at this rank's quadrature points (youngs_modulus_at is const: a record).
+  mutable double youngs_modulus_min_ = std::numeric_limits<double>::infinity();
+  mutable double youngs_modulus_max_ = -std::numeric_limits<double>::infinity();
 };
 
 }  // namespace
@@ -470,6 +478,13 @@ void ElasticityProblem::Implementation::assemble_system() {
                                                   "another rank's cells")
                                     : bad_input);
   linear_system->finish_assembly();
+  const bool field = bool(model.material.youngs_modulus_field);
+  statistics.youngs_modulus_min =
+      field ? Utilities::MPI::min(assembler.youngs_modulus_min(), communicator)
+            : model.material.youngs_modulus;
+  statistics.youngs_modulus_max =
+      field ? Utilities::MPI::max(assembler.youngs_modulus_max(), communicator)
+            : model.material.youngs_modulus;
   for (int c = 0; c < dim; ++c)
     applied_load[c] = Utilities::MPI::sum(load[c], communicator);
   for (std::size_t t = 0; t < model.tractions.size(); ++t)

@@ -238,6 +238,8 @@ VariantResult run_variant(const CaseRun& run, BuiltVariant& built, const std::ve
   r.refinement_added_nodes = built.refinement_added_nodes;
   r.warnings = built.warnings;
   r.parameters = variant_parameters(*built.model);
+  r.parameters["youngs_modulus_range_pa"] = {built.youngs_modulus_range.min,
+                                             built.youngs_modulus_range.max};
   // The first load on the variant itself: the timing starts from its equilibrium, pressed there.
   r.loads.push_back(at_load(run.problem, built, run.loads.front(), path));
   if (settings.time_dynamics)

@@ -14,7 +14,7 @@ namespace msfem::compare {
 namespace {
 
 // Bump when the FEM's formulation or the entry layout changes: old entries then miss.
-constexpr const char* cache_version = "msfem-fem-cache-7";
+constexpr const char* cache_version = "msfem-fem-cache-8";
 
 nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
   return {{"rows", m.rows()},
@@ -98,6 +98,7 @@ std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacemen
   for (double x :
        {p.material.youngs_modulus_pa, p.material.poisson_ratio, p.material.density_kg_per_m3})
     h.number(x);
+  h.text(problem.youngs_modulus_image ? problem.youngs_modulus_image->fingerprint() : "uniform E");
   h.matrix(p.loads.gravity_m_per_s2);
   h.number(static_cast<double>(p.support.kind));
   h.number(p.support.inner_core_scale);
@@ -165,6 +166,8 @@ std::optional<FemCacheEntry> load_fem_cache(const std::filesystem::path& directo
     s.statistics.setup_time_s = st.at("setup_time_s");
     s.statistics.assemble_time_s = st.at("assemble_time_s");
     s.statistics.solve_time_s = st.at("solve_time_s");
+    s.statistics.youngs_modulus_min = st.at("youngs_modulus_min_pa");
+    s.statistics.youngs_modulus_max = st.at("youngs_modulus_max_pa");
     s.contact = contact_from(j, "contact");
     for (const auto& p : j.at("force_depth"))
       e.force_depth.push_back(
@@ -205,7 +208,9 @@ void store_fem_cache(const std::filesystem::path& directory, const std::string& 
                         {"residual_norm", st.residual_norm},
                         {"setup_time_s", st.setup_time_s},
                         {"assemble_time_s", st.assemble_time_s},
-                        {"solve_time_s", st.solve_time_s}}},
+                        {"solve_time_s", st.solve_time_s},
+                        {"youngs_modulus_min_pa", st.youngs_modulus_min},
+                        {"youngs_modulus_max_pa", st.youngs_modulus_max}}},
                       {"force_depth", fd},
                       {"contact", contact_json(s.contact)},
                       {"error_estimate", estimate_json(e.error_estimate)}};

@@ -181,6 +181,9 @@ FemSolution solve_fem(const Problem& problem, const fem_reference::VolumeMesh& m
   fem_reference::ElasticityModel model;
   model.degree = static_cast<unsigned>(p.fem.degree);
   model.material.youngs_modulus = p.material.youngs_modulus_pa;
+  if (problem.youngs_modulus_image)
+    model.material.youngs_modulus_field =
+        [image = problem.youngs_modulus_image](const Eigen::Vector3d& x) { return (*image)(x); };
   model.material.poisson_ratio = p.material.poisson_ratio;
   model.material.density = p.material.density_kg_per_m3;
   model.material.gravity = p.loads.gravity_m_per_s2;

@@ -229,6 +229,30 @@ void refine_at_tools(Problem& problem) {
   problem.local_refinement = local;
 }
 
+// The CT whose HU give E, checked to cover the organ: a surface outside the scan (another
+// patient's image, millimetres read as metres) would take E from the image's edge unnoticed.
+void load_youngs_modulus_image(Problem& problem) {
+  const auto& m = problem.parameters.material;
+  if (m.youngs_modulus_image.empty()) return;
+  const std::string key = problem.parameters.file.string() + ": material/youngs modulus image";
+  try {
+    problem.youngs_modulus_image = std::make_shared<const cases::YoungsModulusImage>(
+        m.youngs_modulus_image, cases::parse_hu_to_youngs(m.hu_to_youngs, "material/hu to youngs"));
+  } catch (const cases::InputError& e) {
+    throw cases::InputError(key + ": " + e.what());
+  }
+  // One voxel of slack: an organ the scan clips is closed one voxel layer outside the scan.
+  const cases::Surface& s = problem.surface;
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    if (!problem.youngs_modulus_image->contains(s.vertices.row(v).transpose(), 1.0))
+      throw cases::InputError(
+          key + ": surface vertex " + std::to_string(v) + " at (" +
+          std::to_string(s.vertices(v, 0)) + ", " + std::to_string(s.vertices(v, 1)) + ", " +
+          std::to_string(s.vertices(v, 2)) +
+          ") m lies outside the image (are the surface and the image in the same world "
+          "coordinates?)");
+}
+
 }  // namespace
 
 fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
@@ -294,6 +318,11 @@ cases::Surface source_surface(const cases::CaseParameters& p, std::vector<std::s
                                                : cases::read_surface(g.source, g.unit);
 }
 
+double youngs_modulus_at(const Problem& problem, const Eigen::Vector3d& x) {
+  return problem.youngs_modulus_image ? (*problem.youngs_modulus_image)(x)
+                                      : problem.parameters.material.youngs_modulus_pa;
+}
+
 Problem make_problem(const cases::CaseParameters& parameters) {
   Problem problem;
   problem.parameters = parameters;
@@ -323,6 +352,7 @@ Problem make_problem(const cases::CaseParameters& parameters) {
     }
   }
   refine_at_tools(problem);
+  load_youngs_modulus_image(problem);
   if (parameters.loads.patch_force.enabled) check_patch_force(problem);
   if (problem.tools.empty() && !parameters.loads.patch_force.enabled &&
       !(parameters.loads.gravity_m_per_s2.norm() > 0))

@@ -116,6 +116,10 @@ void apply_patch_force(ms::MassSpringModel& model, const Problem& problem) {
     model.set_external_force(surface_nodes[v], patch.force_n * areas[v] / total_area);
 }
 
+ms::ModulusField youngs_modulus_field(const Problem& problem) {
+  return [&problem](const Eigen::Vector3d& x) { return youngs_modulus_at(problem, x); };
+}
+
 // The variants whose builders give the volume elements volume preservation acts on.
 bool has_volume_elements(cases::Variant variant) {
   return variant == cases::Variant::three_tier || variant == cases::Variant::tet_edges;
@@ -145,6 +149,9 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
     variant.warnings.push_back(
         "volume preservation: " + std::to_string(removed) + " of " + std::to_string(all) +
         " volume elements are inverted or flat at rest (folded tiers, slivers) and are left out");
+  if (problem.youngs_modulus_image)
+    variant.youngs_modulus_range.include(ms::apply_modulus_field(
+        elements, rest, youngs_modulus_field(problem), p.material.youngs_modulus_pa));
   if (elements.num_elements() > 0)
     model.set_volume(ms::VolumeForceField(model.num_nodes(), std::move(elements)));
 }
@@ -258,6 +265,10 @@ BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
   variant.case_surface_vertices = problem.surface.num_vertices();
   try {
     ms::SpringNetwork network = build_network(kind, problem, mesh);
+    variant.youngs_modulus_range.include(p.material.youngs_modulus_pa);
+    if (problem.youngs_modulus_image)
+      variant.youngs_modulus_range = ms::apply_modulus_field(network, youngs_modulus_field(problem),
+                                                             p.material.youngs_modulus_pa);
     if (kind == cases::Variant::tet_edges) variant.tetrahedra = mesh.tetrahedra;
     if (problem.local_refinement) {
       // three_tier copies the surface into its two inner tiers.

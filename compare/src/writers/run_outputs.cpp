@@ -156,6 +156,28 @@ std::string steppers_timed(const CaseRun& run) {
   return text.empty() ? "no stepper (not timed)" : text;
 }
 
+std::string fmt(const char* format, double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+// The E each model saw: constant, or the image's field through the HU table.
+std::string youngs_modulus_text(const CaseRun& run) {
+  const auto& image = run.problem.youngs_modulus_image;
+  if (!image) return "E = " + fmt("%g", run.problem.parameters.material.youngs_modulus_pa) + " Pa";
+  const auto& st = run.loads.front().fem.statistics;
+  std::string text = "E from the CT `" + image->file().filename().string() + "` (HU:E Pa " +
+                     image->table().describe() + "): FEM " + fmt("%.4g", st.youngs_modulus_min) +
+                     "-" + fmt("%.4g", st.youngs_modulus_max) + " Pa at its quadrature points";
+  for (const auto& v : run.variants)
+    if (const auto range = v.parameters.find("youngs_modulus_range_pa");
+        range != v.parameters.end())
+      text += ", " + v.name + " " + fmt("%.4g", (*range)[0].get<double>()) + "-" +
+              fmt("%.4g", (*range)[1].get<double>()) + " Pa";
+  return text;
+}
+
 std::string report_markdown(const CaseRun& run, const std::vector<std::string>& plots) {
   const auto& p = run.problem.parameters;
   const LoadReference& first = run.loads.front();
@@ -164,9 +186,8 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
      << "- case file: `" << p.file.string() << "`\n"
      << "- surface: `" << p.geometry.source << "`, " << run.problem.surface.num_vertices()
      << " vertices, " << run.problem.surface.num_triangles() << " triangles\n"
-     << "- material: E = " << p.material.youngs_modulus_pa
-     << " Pa, ν = " << p.material.poisson_ratio << ", ρ = " << p.material.density_kg_per_m3
-     << " kg/m³\n"
+     << "- material: " << youngs_modulus_text(run) << ", ν = " << p.material.poisson_ratio
+     << ", ρ = " << p.material.density_kg_per_m3 << " kg/m³\n"
      << "- FEM: P" << p.fem.degree << ", " << first.fem.statistics.dofs << " dofs, "
      << first.fem.statistics.cells << " cells, " << first.fem.statistics.iterations
      << " iterations, " << first.fem.statistics.solve_time_s << " s solve";

@@ -16,6 +16,23 @@
 namespace msfem::compare {
 namespace {
 
+// E as the FEM saw it at its quadrature points (the first load's assembly), and where it came from.
+nlohmann::json material_json(const CaseRun& run) {
+  const auto& m = run.problem.parameters.material;
+  const auto& st = run.loads.front().fem.statistics;
+  nlohmann::json j = {{"youngs_modulus_pa", m.youngs_modulus_pa},
+                      {"youngs_modulus_range_pa", {st.youngs_modulus_min, st.youngs_modulus_max}},
+                      {"youngs_modulus_image", nullptr},
+                      {"hu_to_youngs", nullptr},
+                      {"poisson_ratio", m.poisson_ratio},
+                      {"density_kg_per_m3", m.density_kg_per_m3}};
+  if (const auto& image = run.problem.youngs_modulus_image) {
+    j["youngs_modulus_image"] = image->file().string();
+    j["hu_to_youngs"] = image->table().describe();
+  }
+  return j;
+}
+
 nlohmann::json vec(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
 }
@@ -269,10 +286,7 @@ nlohmann::json summary_json(const CaseRun& run) {
           {"git_revision", git_revision()},
           {"machine", machine_description()},
           {"units", {{"length", "m"}, {"force", "N"}, {"time", "s"}, {"stress", "Pa"}}},
-          {"material",
-           {{"youngs_modulus_pa", p.material.youngs_modulus_pa},
-            {"poisson_ratio", p.material.poisson_ratio},
-            {"density_kg_per_m3", p.material.density_kg_per_m3}}},
+          {"material", material_json(run)},
           {"surface",
            {{"source", p.geometry.source},
             {"vertices", run.problem.surface.num_vertices()},

@@ -41,6 +41,12 @@ struct MaterialParameters {
   double youngs_modulus_pa = 3000.0;
   double poisson_ratio = 0.45;
   double density_kg_per_m3 = 1040.0;
+  /// A CT in Hounsfield units (NIfTI; relative to the case file) whose voxels give E through
+  /// `hu_to_youngs` (see modulus_image.hpp): both models then see that field and
+  /// youngs_modulus_pa is only the scale the analytic spring rules start from. Empty: E is
+  /// youngs_modulus_pa everywhere.
+  std::string youngs_modulus_image;
+  std::string hu_to_youngs;  ///< "HU:E; ..." (Pa), checked by parse_hu_to_youngs
 };
 
 /// The fixed region, stated as geometry; each model fixes the nodes it contains.

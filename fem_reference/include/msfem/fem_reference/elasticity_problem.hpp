@@ -124,6 +124,9 @@ struct SolveStatistics {
   int mpi_ranks = 1;
   int iterations = 0;  ///< Krylov iterations, summed over the contact's active-set iterations
   double residual_norm = 0.0;  ///< final (preconditioned) residual norm
+  /// Smallest and largest E at the quadrature points the stiffness matrix was assembled at (both
+  /// the constant E without a field).
+  double youngs_modulus_min = 0.0, youngs_modulus_max = 0.0;
   double setup_time_s = 0.0;
   double assemble_time_s = 0.0;
   double solve_time_s = 0.0;

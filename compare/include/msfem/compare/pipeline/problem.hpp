@@ -4,11 +4,13 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/modulus_image.hpp"
 #include "msfem/cases/surface.hpp"
 #include "msfem/fem_reference/elasticity_problem.hpp"
 
@@ -46,7 +48,12 @@ struct Problem {
   /// Set when the surface was refined around the tools; the centroid and the fixed region are
   /// those of the surface before (refinement keeps its shape, but not its vertex centroid).
   std::optional<LocalRefinement> local_refinement;
+  /// E from the case's material/youngs modulus image, when it names one (null: E is constant).
+  std::shared_ptr<const cases::YoungsModulusImage> youngs_modulus_image;
 };
+
+/// E(x) in Pa as both models take it: the image's field, or the case's constant E.
+double youngs_modulus_at(const Problem& problem, const Eigen::Vector3d& x);
 
 /// The case's surface as its source gives it (a generator, an image's organ, or a file), before
 /// the case's simplification, smoothing and checks; `notes` gets what extraction did.

@@ -11,6 +11,7 @@
 #include "msfem/compare/pipeline/problem.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/modulus_field.hpp"
 
 namespace msfem::compare {
 
@@ -60,6 +61,8 @@ struct BuiltVariant {
   /// node indices of the model: a spring network has no resistance to their inversion, so runs
   /// count the inverted ones.
   Eigen::MatrixX4i tetrahedra;
+  /// The E its springs and volume elements were given (the case's E, or the image's range).
+  massspring::ModulusRange youngs_modulus_range;
   std::vector<std::string> warnings;
 };
 BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
