@@ -81,9 +81,10 @@ State NaiveAosStepper::state() const {
 
 namespace {
 
-// Median over samples of steps per second; `advance(n)` runs n steps.
+// Steps per second over the samples; `advance(n)` runs n steps.
 template <class Advance>
-double median_rate(Advance advance, int steps_per_call, const SteppingBenchmarkOptions& options) {
+RateSpread rate_spread(Advance advance, int steps_per_call,
+                       const SteppingBenchmarkOptions& options) {
   using clock = std::chrono::steady_clock;
   // Warm-up: caches, page faults, thread start.
   const auto warm_start = clock::now();
@@ -105,8 +106,8 @@ double median_rate(Advance advance, int steps_per_call, const SteppingBenchmarkO
     } while (elapsed < options.seconds_per_sample);
     rates.push_back(static_cast<double>(steps) / elapsed);
   }
-  std::nth_element(rates.begin(), rates.begin() + rates.size() / 2, rates.end());
-  return rates[rates.size() / 2];
+  std::sort(rates.begin(), rates.end());
+  return {rates.front(), rates[rates.size() / 2], rates.back()};
 }
 
 }  // namespace
@@ -120,6 +121,49 @@ State perturbed_start(const MassSpringModel& model) {
     start.x[k] += amplitude * uniform(generator);
   model.enforce_constraints(start.x, start.v);
   return start;
+}
+
+State loaded_start(const MassSpringModel& model) {
+  State start = initial_state(model);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  int free = 0;
+  for (int i = 0; i < model.num_nodes(); ++i)
+    if (!model.is_constrained(i)) {
+      centroid += start.x.segment<3>(3 * i);
+      ++free;
+    }
+  centroid /= std::max(free, 1);
+  for (int i = 0; i < model.num_nodes(); ++i)
+    if (!model.is_constrained(i))
+      start.x.segment<3>(3 * i) += 0.02 * (start.x.segment<3>(3 * i) - centroid);
+  model.enforce_constraints(start.x, start.v);
+  return start;
+}
+
+PrecisionComparison compare_precision(const MassSpringModel& model, double dt, int steps,
+                                      int threads) {
+  const State start = loaded_start(model);
+  const Eigen::VectorXd rest = initial_state(model).x;
+  FastStepperOptions options;
+  options.threads = threads;
+  FastExplicitStepper exact(model, options);
+  options.single_precision = true;
+  FastExplicitStepper single(model, options);
+  exact.set_state(start);
+  single.set_state(start);
+  PrecisionComparison c;
+  for (c.steps = 0; c.steps < steps;) {
+    const int n = std::min(100, steps - c.steps);
+    exact.step(dt, n);
+    single.step(dt, n);
+    c.steps += n;
+    const Eigen::VectorXd x = exact.state().x, y = single.state().x;
+    for (int i = 0; i < model.num_nodes(); ++i) {
+      c.max_node_error_m = std::max(c.max_node_error_m, (x - y).segment<3>(3 * i).norm());
+      c.max_displacement_m = std::max(c.max_displacement_m, (x - rest).segment<3>(3 * i).norm());
+    }
+  }
+  return c;
 }
 
 SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
@@ -138,20 +182,27 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
   FastExplicitStepper fast(model, fast_options);
   fast.set_state(start);
   result.threads = fast.threads();
-  result.explicit_steps_per_second = median_rate([&](int n) { fast.step(result.explicit_dt, n); },
-                                                 options.steps_per_call, options);
+  result.explicit_spread = rate_spread([&](int n) { fast.step(result.explicit_dt, n); },
+                                       options.steps_per_call, options);
+  result.explicit_steps_per_second = result.explicit_spread.median;
+  const bool fields = !model.fields().empty();
+  if (fields)
+    result.notes.push_back(
+        "naive and implicit not run: the naive loop and the fast implicit stepper step springs "
+        "only; the fast explicit stepper steps the force fields on its calling thread");
 
-  if (options.run_naive) {
+  if (options.run_naive && !fields) {
     NaiveAosStepper naive(model, start);
-    result.naive_steps_per_second = median_rate(
+    result.naive_spread = rate_spread(
         [&](int n) {
           for (int k = 0; k < n; ++k)
             naive.step(result.explicit_dt);
         },
         1, options);
+    result.naive_steps_per_second = result.naive_spread.median;
   }
 
-  if (options.run_implicit) {
+  if (options.run_implicit && !fields) {
     FastImplicitOptions implicit_options;
     implicit_options.threads = options.threads;
     implicit_options.cg_tolerance = options.implicit_cg_tolerance;
@@ -160,7 +211,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
     FastImplicitStepper implicit(model, implicit_options);
     implicit.set_state(start);
     long iterations = 0, steps = 0;
-    result.implicit_steps_per_second = median_rate(
+    result.implicit_spread = rate_spread(
         [&](int n) {
           for (int k = 0; k < n; ++k) {
             implicit.step(options.implicit_dt);
@@ -169,8 +220,12 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
           }
         },
         1, options);
+    result.implicit_steps_per_second = result.implicit_spread.median;
     result.implicit_mean_cg_iterations = static_cast<double>(iterations) / std::max(steps, 1L);
   }
+  if (options.compare_precision)
+    result.float_vs_double =
+        compare_precision(model, result.explicit_dt, options.precision_steps, options.threads);
   return result;
 }
 

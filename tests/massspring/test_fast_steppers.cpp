@@ -207,6 +207,28 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   EXPECT_GT(result.explicit_steps_per_second, 0.0);
   EXPECT_GT(result.naive_steps_per_second, 0.0);
   EXPECT_GT(result.implicit_steps_per_second, 0.0);
+  for (const RateSpread* s :
+       {&result.explicit_spread, &result.naive_spread, &result.implicit_spread}) {
+    EXPECT_GT(s->min, 0.0);
+    EXPECT_LE(s->min, s->median);
+    EXPECT_LE(s->median, s->max);
+  }
+  EXPECT_EQ(result.explicit_spread.median, result.explicit_steps_per_second);
+  ASSERT_TRUE(result.float_vs_double);
+  EXPECT_EQ(result.float_vs_double->steps, 1000);
+}
+
+TEST(SteppingBenchmark, FloatFollowsDoubleOnALoadedRun) {
+  // The level-2 sphere dilated 2 %: a few tenths of a millimetre of displacement, 1,000 steps at
+  // half the stable dt. Float keeps within 1e-3 of the largest displacement (its positions are
+  // absolute coordinates: their round-off, 6e-8 of the radius, is what grows).
+  const MassSpringModel model = loaded_three_tier();
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  const PrecisionComparison c = compare_precision(model, dt, 1000, 2);
+  EXPECT_GT(c.max_displacement_m, 1e-4);
+  EXPECT_GT(c.max_node_error_m, 0.0);  // two precisions, not one stepper twice
+  EXPECT_LT(c.relative(), 1e-3);
 }
 
 }  // namespace

@@ -18,10 +18,27 @@ namespace {
 
 constexpr const char* kBrainFile = "brain_icbm152_lh_9177_mm.obj";
 
+nlohmann::json spread_json(const massspring::RateSpread& s) {
+  if (!(s.median > 0)) return nullptr;  // not run
+  return {{"min", s.min}, {"median", s.median}, {"max", s.max}};
+}
+
+nlohmann::json precision_json(const std::optional<massspring::PrecisionComparison>& p) {
+  if (!p) return nullptr;
+  return {{"steps", p->steps},
+          {"max_node_error_m", p->max_node_error_m},
+          {"max_displacement_m", p->max_displacement_m},
+          {"max_node_error_over_max_displacement", p->relative()}};
+}
+
 nlohmann::json to_json(const massspring::BenchmarkCase& c,
                        const massspring::SteppingBenchmarkResult& r,
                        const massspring::SteppingBenchmarkOptions& options) {
+  nlohmann::json warnings = c.network.warnings;
+  for (const auto& note : r.notes)
+    warnings.push_back(note);
   return {{"name", c.name},
+          {"volume_preservation", c.volume_preservation},
           {"description", c.description},
           {"nodes", r.nodes},
           {"springs", r.springs},
@@ -33,9 +50,13 @@ nlohmann::json to_json(const massspring::BenchmarkCase& c,
                                      : 0.0},
           {"implicit_steps_per_second", r.implicit_steps_per_second},
           {"implicit_mean_cg_iterations", r.implicit_mean_cg_iterations},
+          {"explicit_steps_per_second_spread", spread_json(r.explicit_spread)},
+          {"naive_steps_per_second_spread", spread_json(r.naive_spread)},
+          {"implicit_steps_per_second_spread", spread_json(r.implicit_spread)},
+          {"float_vs_double", precision_json(r.float_vs_double)},
           {"explicit_dt_s", r.explicit_dt},
           {"implicit_dt_s", options.implicit_dt},
-          {"warnings", c.network.warnings}};
+          {"warnings", warnings}};
 }
 
 int bench_massspring(const Options& options) {
@@ -73,14 +94,15 @@ int bench_massspring(const Options& options) {
     cases_json.push_back(to_json(c, result, bench_options));
     if (!json)
       std::printf(
-          "%-12s %8d nodes %9d springs  explicit %9.0f steps/s  naive %8.0f steps/s "
-          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)\n",
+          "%-18s %8d nodes %9d springs  explicit %9.0f steps/s (%.0f-%.0f)  naive %8.0f steps/s "
+          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)  float/double %.1e\n",
           c.name.c_str(), result.nodes, result.springs, result.explicit_steps_per_second,
-          result.naive_steps_per_second,
+          result.explicit_spread.min, result.explicit_spread.max, result.naive_steps_per_second,
           result.naive_steps_per_second > 0.0
               ? result.explicit_steps_per_second / result.naive_steps_per_second
               : 0.0,
-          result.implicit_steps_per_second, result.implicit_mean_cg_iterations);
+          result.implicit_steps_per_second, result.implicit_mean_cg_iterations,
+          result.float_vs_double ? result.float_vs_double->relative() : 0.0);
   }
   if (json) {
     const nlohmann::json report = {{"benchmark", "massspring"},
@@ -89,7 +111,9 @@ int bench_massspring(const Options& options) {
                                    {"single_precision", bench_options.single_precision},
                                    {"seconds_per_sample", bench_options.seconds_per_sample},
                                    {"samples", bench_options.samples},
-                                   {"statistic", "median steps per second after warm-up"},
+                                   {"statistic",
+                                    "median steps per second after warm-up; *_spread: min, "
+                                    "median, max over the samples"},
                                    {"cases", cases_json}};
     std::cout << report.dump(2) << "\n";
   }

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "msfem/massspring/integrators.hpp"
@@ -43,6 +45,26 @@ struct SteppingBenchmarkOptions {
   double implicit_dt = 1e-3;            ///< haptic rate
   double implicit_cg_tolerance = 1e-2;  ///< FastImplicitOptions' haptic default
   int implicit_cg_max_iterations = 50;
+  bool compare_precision = true;  ///< run float against double (PrecisionComparison)
+  int precision_steps = 1000;
+};
+
+/// Steps per second over a figure's samples: a spread as wide as the median says the machine, the
+/// threads' placement or the barriers disturbed the run, which a median alone would hide.
+struct RateSpread {
+  double min = 0.0, median = 0.0, max = 0.0;
+};
+
+/// The single-precision explicit stepper against the double one on the same loaded run (both from
+/// loaded_start, the same dt): the largest distance between a node's two positions at any of the
+/// checkpoints, and the largest displacement from rest the double run reached there.
+struct PrecisionComparison {
+  int steps = 0;
+  double max_node_error_m = 0.0;
+  double max_displacement_m = 0.0;
+  double relative() const {
+    return max_displacement_m > 0 ? max_node_error_m / max_displacement_m : 0;
+  }
 };
 
 struct SteppingBenchmarkResult {
@@ -54,6 +76,9 @@ struct SteppingBenchmarkResult {
   double naive_steps_per_second = 0.0;     ///< NaiveAosStepper, median (0 when not run)
   double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
+  RateSpread explicit_spread, naive_spread, implicit_spread;
+  std::optional<PrecisionComparison> float_vs_double;  ///< when options.compare_precision
+  std::vector<std::string> notes;                      ///< figures not taken, and why
 };
 
 /// Measures steps per second of the explicit fast stepper, the naive loop and the implicit fast
@@ -63,6 +88,17 @@ struct SteppingBenchmarkResult {
 /// Rest state with every node moved by a fixed pseudo-random 10⁻³ of the mean spring length: all
 /// springs loaded, the motion bounded. Every speed measurement starts from it.
 State perturbed_start(const MassSpringModel& model);
+
+/// Rest state with every free node moved 2 % of its distance from the free nodes' centroid outwards
+/// (a few millimetres on an organ): every spring loaded as a pressed organ's are, so that a
+/// precision comparison sees the displacements a simulator renders, not round-off of a state at
+/// rest.
+State loaded_start(const MassSpringModel& model);
+
+/// Float against double on the fast explicit stepper (see PrecisionComparison), checkpoints every
+/// 100 steps.
+PrecisionComparison compare_precision(const MassSpringModel& model, double dt, int steps,
+                                      int threads);
 
 SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
                                                const SteppingBenchmarkOptions& options = {});
