@@ -77,13 +77,13 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
  private:
   void step_springs(double dt, int count) {
     const Real h = static_cast<Real>(dt);
-    field_diverged_ = false;
     std::vector<double> check(team_.size(), 0.0);
     // Blocks are taken from one ticket counter. In each step every member draws tickets until it
     // gets one past the step's blocks, so a step uses exactly blocks + members tickets and the
     // next step's tickets start at a known number without resetting the counter.
     const long blocks = static_cast<long>(gather_.block_begin.size()) - 1;
     const long per_step = blocks + team_.size();
+    field_diverged_.store(false, std::memory_order_relaxed);
     ticket_.store(0, std::memory_order_relaxed);
     const std::function<void(int)> job = [&](int member) {
       int from = current_;
@@ -99,12 +99,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
           sum += kernels_.explicit_step(gather_, cur, next, begin, end, h);
         }
         from = 1 - from;
-        // A field's force is read from the step's start like the springs' and added to the new
-        // state once every member has written it, by one member while the others wait.
-        if (!fields_.empty()) {
-          team_.barrier();
-          if (member == 0) add_field_impulses(dt, records_[1 - from].data(), records_[from].data());
-        }
+        if (!fields_.empty())
+          add_field_impulses(member, dt, records_[1 - from].data(), records_[from].data());
         if (n + 1 < count) team_.barrier();  // run() itself waits for the last step
       }
       check[member] = sum;
@@ -115,7 +111,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     double total = 0.0;
     for (double value : check)
       total += value;
-    if (!std::isfinite(total) || field_diverged_) report_divergence(dt);
+    if (!std::isfinite(total) || field_diverged_.load()) report_divergence(dt);
   }
 
  public:
@@ -140,33 +136,53 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     const Eigen::Index dofs = 3 * static_cast<Eigen::Index>(soa_.num_nodes);
     field_x_ = Eigen::VectorXd::Zero(fields_.empty() ? 0 : dofs);
     field_v_ = field_x_;
-    field_f_ = field_x_;
+    field_f_.assign(static_cast<std::size_t>(team_.size()), field_x_);
+  }
+
+  // Member `member`'s share [n·m/M, n·(m+1)/M) of the field nodes.
+  std::pair<std::size_t, std::size_t> field_share(int member) const {
+    const std::size_t n = field_nodes_.size(), members = static_cast<std::size_t>(team_.size());
+    return {n * member / members, n * (member + 1) / members};
   }
 
   // Symplectic Euler with the fields' force f_F(x, v) of the step's start: v' = v'_springs +
-  // h M⁻¹ f_F and x' = x + h v' = x'_springs + h² M⁻¹ f_F, on the free nodes.
-  void add_field_impulses(double dt, const Real* before, Real* after) {
-    for (int node : field_nodes_) {
+  // h M⁻¹ f_F and x' = x + h v' = x'_springs + h² M⁻¹ f_F, on the free nodes. The members share
+  // the work: each gathers its share of the field nodes' x and v, adds its part of every field
+  // (ForceField::add_force_part) into its own force vector, and once all have, sums the members'
+  // forces at its share of the nodes and applies them. Two barriers; none when alone.
+  void add_field_impulses(int member, double dt, const Real* before, Real* after) {
+    Eigen::VectorXd& f = field_f_[static_cast<std::size_t>(member)];
+    for (int node : field_nodes_)
+      f.segment<3>(3 * node).setZero();
+    const auto [first, last] = field_share(member);
+    for (std::size_t k = first; k < last; ++k) {
+      const int node = field_nodes_[k];
       const int i = soa_.new_id[static_cast<std::size_t>(node)];
       for (int c = 0; c < 3; ++c) {
         field_x_[3 * node + c] = before[kRecord * i + c];
         field_v_[3 * node + c] = before[kRecord * i + 3 + c];
-        field_f_[3 * node + c] = 0.0;
       }
     }
+    team_.barrier();  // x and v gathered, and every member's springs written to `after`
     for (const auto& field : fields_)
-      field->add_force(field_x_, field_v_, field_f_);
-    for (int node : field_nodes_) {
+      field->add_force_part(field_x_, field_v_, f, member, team_.size());
+    team_.barrier();
+    bool diverged = false;
+    for (std::size_t k = first; k < last; ++k) {
+      const int node = field_nodes_[k];
       const int i = soa_.new_id[static_cast<std::size_t>(node)];
       if (i >= soa_.num_free) continue;
       for (int c = 0; c < 3; ++c) {
-        const double f = field_f_[3 * node + c];
-        if (!std::isfinite(f)) field_diverged_ = true;
-        const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * f);
+        double force = 0.0;
+        for (const Eigen::VectorXd& part : field_f_)
+          force += part[3 * node + c];
+        if (!std::isfinite(force)) diverged = true;
+        const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * force);
         after[kRecord * i + 3 + c] += dv;
         after[kRecord * i + c] += static_cast<Real>(dt) * dv;
       }
     }
+    if (diverged) field_diverged_.store(true, std::memory_order_relaxed);
   }
 
   // Both record buffers from the layout's per-component arrays: the constrained nodes are read
@@ -210,8 +226,9 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   detail::AlignedVector<Real> records_[2];  // x, v per node (kRecord), previous and next step
   std::vector<std::shared_ptr<const ForceField>> fields_;
   std::vector<int> field_nodes_;  ///< original node ids
-  Eigen::VectorXd field_x_, field_v_, field_f_;
-  bool field_diverged_ = false;
+  Eigen::VectorXd field_x_, field_v_;
+  std::vector<Eigen::VectorXd> field_f_;  ///< per member
+  std::atomic<bool> field_diverged_{false};
   std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;

@@ -75,6 +75,14 @@ class ForceField : public ForceModel {
   /// This field with `group`'s coefficients multiplied by `factor`; throws ModelError for a group
   /// it does not have.
   virtual std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const;
+  /// Part `part` of `parts` of add_force, so that threads each adding one part into their own f
+  /// together add the whole force (the fast explicit stepper shares a field among its threads this
+  /// way). By default part 0 is the whole force and the other parts are nothing.
+  virtual void add_force_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                              Eigen::VectorXd& f, int part, int parts) const {
+    (void)parts;
+    if (part == 0) add_force(x, v, f);
+  }
 };
 
 }  // namespace msfem::massspring

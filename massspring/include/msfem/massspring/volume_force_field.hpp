@@ -1,6 +1,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include "msfem/massspring/force_model.hpp"
@@ -37,6 +39,10 @@ class VolumeForceField : public ForceField {
   int num_dofs() const override { return 3 * num_nodes_; }
   void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                  Eigen::VectorXd& f) const override;
+  /// Elements [E·part/parts, E·(part+1)/parts) only: threads that each take a part into their own
+  /// f sum to add_force.
+  void add_force_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f,
+                      int part, int parts) const override;
   double potential_energy(const Eigen::VectorXd& x) const override;
   void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                         const Eigen::VectorXd& dx, Eigen::VectorXd& df,
@@ -60,9 +66,18 @@ class VolumeForceField : public ForceField {
   double volume(const Eigen::VectorXd& x, int e) const;
 
  private:
+  static constexpr int kMaxElementNodes = 16;
+  void index_element_nodes();
+
   int num_nodes_;
   VolumeElements elements_;
   std::vector<int> nodes_;  ///< of its elements, ascending
+  // Each element's distinct nodes (as offsets 3·id into x and f) and its tetrahedra's corners as
+  // indices into them, so that add_force reads and writes each node of an element once: a shell
+  // prism's nine tetrahedra touch its six nodes 36 times per pass.
+  std::vector<int> element_node_start_{0};
+  std::vector<int> element_node_offset_;
+  std::vector<std::array<std::uint8_t, 4>> local_tets_;
 };
 
 /// The prisms between a triangle mesh's tiers: for every triangle (a, b, c) of `triangles` and
