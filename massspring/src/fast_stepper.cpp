@@ -40,7 +40,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         soa_(model, options.reorder_nodes),
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
-                 detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))} {
+                 detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))},
+        symplectic_(options.symplectic) {
     take_fields(model);
     pack();
   }
@@ -96,7 +97,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
              block < blocks;
              block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step) {
           const int begin = gather_.block_begin[block], end = gather_.block_begin[block + 1];
-          sum += kernels_.explicit_step(gather_, cur, next, begin, end, h);
+          sum += kernels_.explicit_step(gather_, cur, next, begin, end, h, symplectic_);
         }
         from = 1 - from;
         if (!fields_.empty())
@@ -146,7 +147,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   }
 
   // Symplectic Euler with the fields' force f_F(x, v) of the step's start: v' = v'_springs +
-  // h M⁻¹ f_F and x' = x + h v' = x'_springs + h² M⁻¹ f_F, on the free nodes. The members share
+  // h M⁻¹ f_F and x' = x + h v' = x'_springs + h² M⁻¹ f_F, on the free nodes (explicit Euler: x'
+  // advances with the starting v, so only v' takes the field's impulse). The members share
   // the work: each gathers its share of the field nodes' x and v, adds its part of every field
   // (ForceField::add_force_part) into its own force vector, and once all have, sums the members'
   // forces at its share of the nodes and applies them. Two barriers; none when alone.
@@ -179,7 +181,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         if (!std::isfinite(force)) diverged = true;
         const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * force);
         after[kRecord * i + 3 + c] += dv;
-        after[kRecord * i + c] += static_cast<Real>(dt) * dv;
+        if (symplectic_) after[kRecord * i + c] += static_cast<Real>(dt) * dv;
       }
     }
     if (diverged) field_diverged_.store(true, std::memory_order_relaxed);
@@ -232,6 +234,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;
+  bool symplectic_ = true;
   detail::Kernels<Real, W> kernels_;
 };
 

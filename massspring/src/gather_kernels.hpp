@@ -166,16 +166,11 @@ class Kernels {
  public:
   Kernels() : avx2_(cpu_has_avx2()) {}
 
+  // symplectic false: explicit Euler (x advances with the step's starting v).
   double explicit_step(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next, int begin,
-                       int end, Real h) const {
-    switch (g.spring_damping) {
-      case SpringDamping::none:
-        return explicit_step_for<SpringDamping::none>(g, cur, next, begin, end, h);
-      case SpringDamping::uniform:
-        return explicit_step_for<SpringDamping::uniform>(g, cur, next, begin, end, h);
-      default:
-        return explicit_step_for<SpringDamping::per_spring>(g, cur, next, begin, end, h);
-    }
+                       int end, Real h, bool symplectic = true) const {
+    if (!symplectic) return explicit_step_damped<false>(g, cur, next, begin, end, h);
+    return explicit_step_damped<true>(g, cur, next, begin, end, h);
   }
   void linearise_start(const NodeGatherLayout<Real, W>& g, const Real* records,
                        const Real* dv_records, ImplicitCoefficients<Real>& sys,
@@ -214,17 +209,32 @@ class Kernels {
   template <class T>
   using Avx2 = std::conditional_t<std::is_same_v<T, float>, Avx2Float, Avx2Double>;
 #endif
-  template <SpringDamping Damped>
+  template <bool Symplectic>
+  double explicit_step_damped(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
+                              int begin, int end, Real h) const {
+    switch (g.spring_damping) {
+      case SpringDamping::none:
+        return explicit_step_for<SpringDamping::none, Symplectic>(g, cur, next, begin, end, h);
+      case SpringDamping::uniform:
+        return explicit_step_for<SpringDamping::uniform, Symplectic>(g, cur, next, begin, end, h);
+      default:
+        return explicit_step_for<SpringDamping::per_spring, Symplectic>(g, cur, next, begin, end,
+                                                                        h);
+    }
+  }
+  template <SpringDamping Damped, bool Symplectic>
   double explicit_step_for(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
                            int begin, int end, Real h) const {
 #if MSFEM_HAVE_X86_DISPATCH
     if constexpr (W == 16) {
-      return explicit_chunks_avx512<Avx512Float, Damped>(g, cur, next, begin, end, h);
+      return explicit_chunks_avx512<Avx512Float, Damped, Symplectic>(g, cur, next, begin, end, h);
     } else if constexpr (W == 32 / sizeof(Real)) {
-      if (avx2_) return explicit_chunks_avx2<Avx2<Real>, Damped>(g, cur, next, begin, end, h);
+      if (avx2_)
+        return explicit_chunks_avx2<Avx2<Real>, Damped, Symplectic>(g, cur, next, begin, end, h);
     }
 #endif
-    return explicit_chunks_portable<PortableLanes<Real, W>, Damped>(g, cur, next, begin, end, h);
+    return explicit_chunks_portable<PortableLanes<Real, W>, Damped, Symplectic>(g, cur, next, begin,
+                                                                                end, h);
   }
   template <SpringDamping Damped>
   void linearise_start_for(const NodeGatherLayout<Real, W>& g, const Real* records,

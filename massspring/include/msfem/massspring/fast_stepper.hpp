@@ -12,11 +12,15 @@ struct FastStepperOptions {
   bool single_precision = false;  ///< float arithmetic (twice the SIMD width, ~1e-7 relative)
   bool reorder_nodes = true;      ///< reverse Cuthill-McKee order for memory locality
   bool allow_avx512 = true;       ///< float: 16 lanes where the CPU has AVX-512 (else 8, AVX2)
+  /// false: explicit (forward) Euler, x ← x + h v with the step's starting v, on the same kernels
+  /// (the generic Integrator's explicit_euler, at the speed of the symplectic step).
+  bool symplectic = true;
 };
 
 /// The real-time explicit stepper: symplectic Euler, which with velocities read at half steps is
 /// the central-difference (leapfrog) scheme of the pancreas paper,
 ///   v ← v + h M⁻¹ f(x, v),   x ← x + h v,
+/// or explicit Euler (FastStepperOptions::symplectic off: x advances with the step's starting v),
 /// on the model's springs, dampers, node damping, gravity, external forces and supports, and its
 /// force fields (the tool's contact, volume preservation): each step adds a field's force, taken
 /// from the step's start like the springs', to the field's free nodes after the spring kernels. A
