@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <thread>
 
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
@@ -123,6 +124,32 @@ State perturbed_start(const MassSpringModel& model) {
   return start;
 }
 
+double stream_triad_bandwidth(int threads, int repeats) {
+  const std::size_t n = std::size_t(8) << 20;  // 64 MiB of doubles per array
+  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
+  threads = std::max(threads, 1);
+  auto triad = [&](int part) {
+    const std::size_t first = n * part / threads, last = n * (part + 1) / threads;
+    for (std::size_t i = first; i < last; ++i)
+      a[i] = b[i] + 3.0 * c[i];
+  };
+  double best = 0.0;
+  for (int r = 0; r < std::max(repeats, 1); ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> team;
+    for (int t = 1; t < threads; ++t)
+      team.emplace_back(triad, t);
+    triad(0);
+    for (auto& t : team)
+      t.join();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = std::max(best, 3.0 * sizeof(double) * n / seconds);  // read b, c; write a
+  }
+  if (a[n / 2] != 7.0) return 0.0;  // keeps the loop from being optimised away
+  return best;
+}
+
 State loaded_start(const MassSpringModel& model) {
   State start = initial_state(model);
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -182,6 +209,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
   FastExplicitStepper fast(model, fast_options);
   fast.set_state(start);
   result.threads = fast.threads();
+  result.explicit_bytes_per_step = fast.streamed_bytes_per_step();
   result.explicit_spread = rate_spread([&](int n) { fast.step(result.explicit_dt, n); },
                                        options.steps_per_call, options);
   result.explicit_steps_per_second = result.explicit_spread.median;

@@ -24,6 +24,7 @@ class FastExplicitStepper::Implementation {
   virtual int num_nodes() const = 0;
   virtual int num_springs() const = 0;
   virtual int threads() const = 0;
+  virtual std::size_t streamed_bytes_per_step() const = 0;
 };
 
 namespace {
@@ -119,6 +120,14 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
   int threads() const override { return team_.size(); }
+  std::size_t streamed_bytes_per_step() const override {
+    const std::size_t lanes = gather_.lane_offset.size(), slots = gather_.neighbour.size();
+    const std::size_t per_slot =
+        sizeof(int) +
+        (gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) * sizeof(Real);
+    return lanes * (sizeof(int) + 6 * sizeof(Real)) + slots * per_slot +
+           gather_.chunk_slot.size() * sizeof(int) + 2 * records_[0].size() * sizeof(Real);
+  }
 
  private:
   // The model's force fields and the nodes they read and push: gathered into full-size vectors
@@ -274,6 +283,9 @@ int FastExplicitStepper::num_springs() const {
 }
 int FastExplicitStepper::threads() const {
   return impl_->threads();
+}
+std::size_t FastExplicitStepper::streamed_bytes_per_step() const {
+  return impl_->streamed_bytes_per_step();
 }
 
 }  // namespace msfem::massspring

@@ -236,6 +236,19 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   EXPECT_EQ(result.explicit_spread.median, result.explicit_steps_per_second);
   ASSERT_TRUE(result.float_vs_double);
   EXPECT_EQ(result.float_vs_double->steps, 1000);
+  // At least the records read and written (8 doubles a node) and k, k l0 of both ends of every
+  // spring; padding makes it more, but not twice more.
+  const std::size_t least = 2 * 8 * sizeof(double) * 486 + 2 * 2 * sizeof(double) * result.springs;
+  EXPECT_GE(result.explicit_bytes_per_step, least);
+  EXPECT_LT(result.explicit_bytes_per_step, 3 * least);
+}
+
+TEST(SteppingBenchmark, StreamTriadMeasuresABandwidth) {
+  // Any machine that runs the tests streams more than 100 MB/s; a loop the compiler dropped, or
+  // a wrong byte count, would not give a finite positive figure in this range.
+  const double bandwidth = stream_triad_bandwidth(2, 1);
+  EXPECT_GT(bandwidth, 1e8);
+  EXPECT_LT(bandwidth, 1e13);
 }
 
 TEST(SteppingBenchmark, FloatFollowsDoubleOnALoadedRun) {

@@ -33,7 +33,8 @@ nlohmann::json precision_json(const std::optional<massspring::PrecisionCompariso
 
 nlohmann::json to_json(const massspring::BenchmarkCase& c,
                        const massspring::SteppingBenchmarkResult& r,
-                       const massspring::SteppingBenchmarkOptions& options) {
+                       const massspring::SteppingBenchmarkOptions& options, double stream) {
+  const double explicit_bandwidth = r.explicit_bytes_per_step * r.explicit_steps_per_second;
   nlohmann::json warnings = c.network.warnings;
   for (const auto& note : r.notes)
     warnings.push_back(note);
@@ -54,6 +55,9 @@ nlohmann::json to_json(const massspring::BenchmarkCase& c,
           {"naive_steps_per_second_spread", spread_json(r.naive_spread)},
           {"implicit_steps_per_second_spread", spread_json(r.implicit_spread)},
           {"float_vs_double", precision_json(r.float_vs_double)},
+          {"explicit_bytes_per_step", r.explicit_bytes_per_step},
+          {"explicit_bytes_per_second", explicit_bandwidth},
+          {"explicit_fraction_of_stream_bandwidth", stream > 0 ? explicit_bandwidth / stream : 0.0},
           {"explicit_dt_s", r.explicit_dt},
           {"implicit_dt_s", options.implicit_dt},
           {"warnings", warnings}};
@@ -87,22 +91,30 @@ int bench_massspring(const Options& options) {
   if (!(bench_options.seconds_per_sample > 0.0))
     throw std::invalid_argument("option --seconds must be > 0");
 
+  // The roofline: a memory-bound step can go no faster than this machine streams its bytes.
+  const double stream = massspring::stream_triad_bandwidth(bench_options.threads);
+  if (!json) std::printf("stream triad bandwidth %.2f GB/s\n", 1e-9 * stream);
   nlohmann::json cases_json = nlohmann::json::array();
   for (const auto& c :
        massspring::benchmark_cases(brain_vertices, brain_triangles, !options.flag("no-10x"))) {
     const auto result = massspring::run_benchmark_case(c, bench_options);
-    cases_json.push_back(to_json(c, result, bench_options));
+    cases_json.push_back(to_json(c, result, bench_options, stream));
     if (!json)
       std::printf(
           "%-18s %8d nodes %9d springs  explicit %9.0f steps/s (%.0f-%.0f)  naive %8.0f steps/s "
-          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)  float/double %.1e\n",
+          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)  float/double %.1e  explicit %.2f GB/s "
+          "(%.0f %% of stream)\n",
           c.name.c_str(), result.nodes, result.springs, result.explicit_steps_per_second,
           result.explicit_spread.min, result.explicit_spread.max, result.naive_steps_per_second,
           result.naive_steps_per_second > 0.0
               ? result.explicit_steps_per_second / result.naive_steps_per_second
               : 0.0,
           result.implicit_steps_per_second, result.implicit_mean_cg_iterations,
-          result.float_vs_double ? result.float_vs_double->relative() : 0.0);
+          result.float_vs_double ? result.float_vs_double->relative() : 0.0,
+          1e-9 * result.explicit_bytes_per_step * result.explicit_steps_per_second,
+          stream > 0
+              ? 100.0 * result.explicit_bytes_per_step * result.explicit_steps_per_second / stream
+              : 0.0);
   }
   if (json) {
     const nlohmann::json report = {{"benchmark", "massspring"},
@@ -110,6 +122,7 @@ int bench_massspring(const Options& options) {
                                    {"threads", bench_options.threads},
                                    {"single_precision", bench_options.single_precision},
                                    {"seconds_per_sample", bench_options.seconds_per_sample},
+                                   {"stream_triad_bytes_per_second", stream},
                                    {"samples", bench_options.samples},
                                    {"statistic",
                                     "median steps per second after warm-up; *_spread: min, "

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <memory>
 
 #include "msfem/massspring/integrators.hpp"
@@ -59,6 +60,11 @@ class FastExplicitStepper {
   int num_nodes() const;
   int num_springs() const;
   int threads() const;
+  /// Bytes a spring step streams at the least: every slot's neighbour index, k, k l0 (and c), every
+  /// lane's index and per-node coefficients, and the node records read and written once, as if
+  /// every neighbour's record were a cache hit. With steps per second, the memory bandwidth a step
+  /// uses (the roofline of a memory-bound kernel).
+  std::size_t streamed_bytes_per_step() const;
 
   class Implementation;  // float and double kernels behind one interface
 

@@ -77,6 +77,7 @@ struct SteppingBenchmarkResult {
   double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
   RateSpread explicit_spread, naive_spread, implicit_spread;
+  std::size_t explicit_bytes_per_step = 0;  ///< FastExplicitStepper::streamed_bytes_per_step
   std::optional<PrecisionComparison> float_vs_double;  ///< when options.compare_precision
   std::vector<std::string> notes;                      ///< figures not taken, and why
 };
@@ -88,6 +89,10 @@ struct SteppingBenchmarkResult {
 /// Rest state with every node moved by a fixed pseudo-random 10⁻³ of the mean spring length: all
 /// springs loaded, the motion bounded. Every speed measurement starts from it.
 State perturbed_start(const MassSpringModel& model);
+
+/// This machine's streaming memory bandwidth in bytes per second: the STREAM triad a = b + s c on
+/// three 64 MiB arrays (far beyond any cache), split over `threads` threads, best of `repeats`.
+double stream_triad_bandwidth(int threads, int repeats = 5);
 
 /// Rest state with every free node moved 2 % of its distance from the free nodes' centroid outwards
 /// (a few millimetres on an organ): every spring loaded as a pressed organ's are, so that a
