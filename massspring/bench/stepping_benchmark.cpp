@@ -213,6 +213,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
   result.explicit_spread = rate_spread([&](int n) { fast.step(result.explicit_dt, n); },
                                        options.steps_per_call, options);
   result.explicit_steps_per_second = result.explicit_spread.median;
+  result.explicit_last_step_threads = fast.last_step_threads();
   const bool fields = !model.fields().empty();
   if (fields)
     result.notes.push_back(

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "adaptive_threads.hpp"
 #include "gather_kernels.hpp"
 #include "soa_layout.hpp"
 #include "thread_team.hpp"
@@ -37,6 +38,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       : model_(&model),
         options_(options),
         team_(std::max(options.threads, 1)),
+        threads_(team_.size(), options.adaptive_threads),
         soa_(model, options.reorder_nodes),
         gather_(soa_),
         records_(kRecord * (soa_.num_nodes + 2)),
@@ -64,7 +66,6 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       member_block_.push_back(static_cast<int>(static_cast<long>(blocks()) * m / team_.size()));
     for (auto& sums : block_sums_)
       sums.assign(3 * static_cast<std::size_t>(blocks()), 0.0);
-    current_members_ = team_.size();
     pack();
   }
 
@@ -90,7 +91,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     return out;
   }
   int last_iterations() const override { return last_iterations_; }
-  int last_threads() const override { return last_members_; }
+  int last_threads() const override { return threads_.last(); }
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
 
@@ -99,7 +100,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   void step(double dt) override {
     check_time_step(dt);
     const Real h = static_cast<Real>(dt);
-    const int members = choose_members();
+    const int members = threads_.choose();
     const auto start = std::chrono::steady_clock::now();
     int iterations = 0;
     const std::function<void(int)> job = [&](int member) {
@@ -177,36 +178,11 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     last_iterations_ = iterations;
     time_ += dt;
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
-    record_time(members, took.count() / (iterations + 2.0));
+    threads_.record(members, took.count() / (iterations + 2.0));  // per product
   }
 
  private:
   int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
-
-  // With adaptive_threads, steps run on the whole team or on the calling thread alone, whichever
-  // took less time per product lately: runs of period_ steps, each followed by kProbe steps the
-  // other way; a probe 10 % faster than the run's last kProbe steps switches. The period doubles
-  // after each probe that does not switch (up to kMaxPeriod: the probes' cost on a steady machine
-  // stays near 1.5 %) and drops back to kMinPeriod after a switch.
-  static constexpr int kMinPeriod = 32, kMaxPeriod = 256, kProbe = 4;
-  int choose_members() const {
-    if (team_.size() == 1 || !options_.adaptive_threads) return team_.size();
-    const int other = current_members_ == 1 ? team_.size() : 1;
-    return run_ < period_ ? current_members_ : other;
-  }
-  void record_time(int members, double seconds_per_product) {
-    last_members_ = members;
-    if (team_.size() == 1 || !options_.adaptive_threads) return;
-    if (run_ >= period_ - kProbe && run_ < period_) current_time_ += seconds_per_product;
-    if (run_ >= period_) probe_time_ += seconds_per_product;
-    if (++run_ == period_ + kProbe) {
-      const bool faster = probe_time_ < 0.9 * current_time_;
-      if (faster) current_members_ = members;
-      period_ = faster ? kMinPeriod : std::min(2 * period_, kMaxPeriod);
-      run_ = 0;
-      current_time_ = probe_time_ = 0.0;
-    }
-  }
 
   // The node records from the layout's arrays. The Δv records keep Δv for the next warm start
   // (zero at construction, as Δv is).
@@ -231,6 +207,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   const MassSpringModel* model_;
   FastImplicitOptions options_;
   detail::ThreadTeam team_;
+  detail::AdaptiveThreads threads_;
   detail::SoaLayout<Real> soa_;
   detail::NodeGatherLayout<Real, W> gather_;
   detail::Kernels<Real, W> kernels_;
@@ -247,8 +224,6 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::CgVectors<Real> cg_;
   std::vector<int> member_block_;      // the members' first blocks, then the number of blocks
   std::vector<double> block_sums_[2];  // per block of chunks: three partial sums
-  int current_members_ = 1, last_members_ = 1, run_ = 0, period_ = kMinPeriod;
-  double current_time_ = 0.0, probe_time_ = 0.0;
   double time_ = 0.0;
   int last_iterations_ = 0;
 };

@@ -3,9 +3,11 @@
 #include "msfem/massspring/fast_stepper.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
+#include "adaptive_threads.hpp"
 #include "gather_kernels.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/stability.hpp"
@@ -24,6 +26,7 @@ class FastExplicitStepper::Implementation {
   virtual int num_nodes() const = 0;
   virtual int num_springs() const = 0;
   virtual int threads() const = 0;
+  virtual int last_step_threads() const = 0;
   virtual std::size_t streamed_bytes_per_step() const = 0;
 };
 
@@ -38,6 +41,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   GatherExplicitStepper(const MassSpringModel& model, const FastStepperOptions& options)
       : model_(&model),
         team_(std::max(options.threads, 1)),
+        threads_(team_.size(), options.adaptive_threads),
         soa_(model, options.reorder_nodes),
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
@@ -73,18 +77,22 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
   void step(double dt, int count) override {
     check_time_step(dt);
-    step_springs(dt, count);
+    const int members = threads_.choose();
+    const auto start = std::chrono::steady_clock::now();
+    step_springs(dt, count, members);
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+    threads_.record(members, took.count() / count);  // per step
   }
 
  private:
-  void step_springs(double dt, int count) {
+  void step_springs(double dt, int count, int members) {
     const Real h = static_cast<Real>(dt);
     std::vector<double> check(team_.size(), 0.0);
     // Blocks are taken from one ticket counter. In each step every member draws tickets until it
     // gets one past the step's blocks, so a step uses exactly blocks + members tickets and the
     // next step's tickets start at a known number without resetting the counter.
     const long blocks = static_cast<long>(gather_.block_begin.size()) - 1;
-    const long per_step = blocks + team_.size();
+    const long per_step = blocks + members;
     field_diverged_.store(false, std::memory_order_relaxed);
     ticket_.store(0, std::memory_order_relaxed);
     const std::function<void(int)> job = [&](int member) {
@@ -102,12 +110,16 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         }
         from = 1 - from;
         if (!fields_.empty())
-          add_field_impulses(member, dt, records_[1 - from].data(), records_[from].data());
-        if (n + 1 < count) team_.barrier();  // run() itself waits for the last step
+          add_field_impulses(member, members, dt, records_[1 - from].data(), records_[from].data());
+        // run() itself waits for the last step
+        if (n + 1 < count && members > 1) team_.barrier();
       }
       check[member] = sum;
     };
-    team_.run(job);
+    if (members == 1)
+      job(0);
+    else
+      team_.run(job);
     current_ = (current_ + count) % 2;
     time_ += dt * count;
     double total = 0.0;
@@ -120,6 +132,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
   int threads() const override { return team_.size(); }
+  int last_step_threads() const override { return threads_.last(); }
   std::size_t streamed_bytes_per_step() const override {
     const std::size_t lanes = gather_.lane_offset.size(), slots = gather_.neighbour.size();
     const std::size_t per_slot =
@@ -150,8 +163,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   }
 
   // Member `member`'s share [n·m/M, n·(m+1)/M) of the field nodes.
-  std::pair<std::size_t, std::size_t> field_share(int member) const {
-    const std::size_t n = field_nodes_.size(), members = static_cast<std::size_t>(team_.size());
+  std::pair<std::size_t, std::size_t> field_share(int member, int members) const {
+    const std::size_t n = field_nodes_.size();
     return {n * member / members, n * (member + 1) / members};
   }
 
@@ -161,11 +174,11 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   // the work: each gathers its share of the field nodes' x and v, adds its part of every field
   // (ForceField::add_force_part) into its own force vector, and once all have, sums the members'
   // forces at its share of the nodes and applies them. Two barriers; none when alone.
-  void add_field_impulses(int member, double dt, const Real* before, Real* after) {
+  void add_field_impulses(int member, int members, double dt, const Real* before, Real* after) {
     Eigen::VectorXd& f = field_f_[static_cast<std::size_t>(member)];
     for (int node : field_nodes_)
       f.segment<3>(3 * node).setZero();
-    const auto [first, last] = field_share(member);
+    const auto [first, last] = field_share(member, members);
     for (std::size_t k = first; k < last; ++k) {
       const int node = field_nodes_[k];
       const int i = soa_.new_id[static_cast<std::size_t>(node)];
@@ -174,10 +187,10 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         field_v_[3 * node + c] = before[kRecord * i + 3 + c];
       }
     }
-    team_.barrier();  // x and v gathered, and every member's springs written to `after`
+    if (members > 1) team_.barrier();  // x, v gathered; every member's springs written to `after`
     for (const auto& field : fields_)
-      field->add_force_part(field_x_, field_v_, f, member, team_.size());
-    team_.barrier();
+      field->add_force_part(field_x_, field_v_, f, member, members);
+    if (members > 1) team_.barrier();
     bool diverged = false;
     for (std::size_t k = first; k < last; ++k) {
       const int node = field_nodes_[k];
@@ -185,8 +198,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
       if (i >= soa_.num_free) continue;
       for (int c = 0; c < 3; ++c) {
         double force = 0.0;
-        for (const Eigen::VectorXd& part : field_f_)
-          force += part[3 * node + c];
+        for (int m = 0; m < members; ++m)
+          force += field_f_[static_cast<std::size_t>(m)][3 * node + c];
         if (!std::isfinite(force)) diverged = true;
         const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * force);
         after[kRecord * i + 3 + c] += dv;
@@ -232,6 +245,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
   const MassSpringModel* model_;
   detail::ThreadTeam team_;
+  detail::AdaptiveThreads threads_;
   detail::SoaLayout<Real> soa_;
   NodeGatherLayout<Real, W> gather_;
   detail::AlignedVector<Real> records_[2];  // x, v per node (kRecord), previous and next step
@@ -283,6 +297,9 @@ int FastExplicitStepper::num_springs() const {
 }
 int FastExplicitStepper::threads() const {
   return impl_->threads();
+}
+int FastExplicitStepper::last_step_threads() const {
+  return impl_->last_step_threads();
 }
 std::size_t FastExplicitStepper::streamed_bytes_per_step() const {
   return impl_->streamed_bytes_per_step();

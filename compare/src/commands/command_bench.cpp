@@ -44,6 +44,7 @@ nlohmann::json to_json(const massspring::BenchmarkCase& c,
           {"nodes", r.nodes},
           {"springs", r.springs},
           {"threads", r.threads},
+          {"explicit_last_step_threads", r.explicit_last_step_threads},
           {"explicit_steps_per_second", r.explicit_steps_per_second},
           {"naive_steps_per_second", r.naive_steps_per_second},
           {"speedup_over_naive", r.naive_steps_per_second > 0.0

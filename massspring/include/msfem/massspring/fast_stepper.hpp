@@ -16,6 +16,12 @@ struct FastStepperOptions {
   /// false: explicit (forward) Euler, x ← x + h v with the step's starting v, on the same kernels
   /// (the generic Integrator's explicit_euler, at the speed of the symplectic step).
   bool symplectic = true;
+  /// Each step(dt, count) call on the whole team or on the calling thread alone, whichever took
+  /// less time per step lately (re-checked by 4 calls on the other count after every 32 to 256):
+  /// on a machine whose cores other jobs hold, a small model's barrier waits make two threads
+  /// slower than one. Results do not depend on it (each node is updated by the same arithmetic on
+  /// any thread).
+  bool adaptive_threads = true;
 };
 
 /// The real-time explicit stepper: symplectic Euler, which with velocities read at half steps is
@@ -60,6 +66,8 @@ class FastExplicitStepper {
   int num_nodes() const;
   int num_springs() const;
   int threads() const;
+  /// Threads the last step(dt, count) call ran on (1 while adaptive_threads found one faster).
+  int last_step_threads() const;
   /// Bytes a spring step streams at the least: every slot's neighbour index, k, k l0 (and c), every
   /// lane's index and per-node coefficients, and the node records read and written once, as if
   /// every neighbour's record were a cache hit. With steps per second, the memory bandwidth a step

@@ -77,7 +77,9 @@ struct SteppingBenchmarkResult {
   double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
   RateSpread explicit_spread, naive_spread, implicit_spread;
-  std::size_t explicit_bytes_per_step = 0;  ///< FastExplicitStepper::streamed_bytes_per_step
+  std::size_t explicit_bytes_per_step = 0;
+  int explicit_last_step_threads = 0;  ///< where adaptive threads ended (1 or threads)  ///<
+                                       ///< FastExplicitStepper::streamed_bytes_per_step
   std::optional<PrecisionComparison> float_vs_double;  ///< when options.compare_precision
   std::vector<std::string> notes;                      ///< figures not taken, and why
 };
