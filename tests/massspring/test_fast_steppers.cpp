@@ -84,6 +84,36 @@ TEST(FastExplicitStepper, MatchesExplicitEulerOnTheSameKernels) {
   EXPECT_GT(relative_difference(symplectic, reference, model.rest_state()), 1e-4);
 }
 
+TEST(FastExplicitStepper, AdaptiveThreadsProbeBothCountsAndChangeNoResult) {
+  const MassSpringModel model = loaded_three_tier();
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  for (bool single_precision : {false, true}) {
+    FastStepperOptions fixed;
+    fixed.threads = 2;
+    fixed.single_precision = single_precision;
+    fixed.adaptive_threads = false;
+    FastStepperOptions adaptive = fixed;
+    adaptive.adaptive_threads = true;
+    FastStepperOptions one = fixed;
+    one.threads = 1;
+    FastExplicitStepper a(model, fixed), b(model, adaptive), c(model, one);
+    int seen[3] = {0, 0, 0};
+    for (int call = 0; call < 300; ++call) {
+      a.step(dt, 2);
+      b.step(dt, 2);
+      c.step(dt, 2);
+      ++seen[b.last_step_threads()];
+    }
+    EXPECT_GE(seen[1], 8) << single_precision;  // the probes at least
+    EXPECT_GE(seen[2], 8) << single_precision;
+    EXPECT_EQ(a.last_step_threads(), 2);
+    EXPECT_EQ((a.state().x - b.state().x).cwiseAbs().maxCoeff(), 0.0) << single_precision;
+    EXPECT_EQ((a.state().v - b.state().v).cwiseAbs().maxCoeff(), 0.0) << single_precision;
+    EXPECT_EQ((a.state().x - c.state().x).cwiseAbs().maxCoeff(), 0.0) << single_precision;
+  }
+}
+
 // Damping that differs between springs takes the per-spring path of the kernels (a uniform
 // damping, as in loaded_three_tier, takes another).
 TEST(FastExplicitStepper, MatchesSymplecticEulerWithPerSpringDamping) {
