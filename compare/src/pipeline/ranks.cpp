@@ -170,6 +170,13 @@ std::string broadcast_from_root(const std::string& bytes) {
   return result;
 }
 
+bool on_every_rank(bool value) {
+  if (count() == 1) return value;
+  int mine = value ? 1 : 0, all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  return all == 1;
+}
+
 void idle_barrier() {
   if (count() == 1) return;
   MPI_Request request;

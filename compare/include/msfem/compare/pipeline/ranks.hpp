@@ -41,6 +41,9 @@ std::vector<std::string> gather_on_all(const std::string& bytes);
 /// Rank 0's `bytes` on every rank.
 std::string broadcast_from_root(const std::string& bytes);
 
+/// Whether `value` is true on every rank.
+bool on_every_rank(bool value);
+
 /// Returns when every rank has called it. A waiting rank sleeps rather than polls at full speed,
 /// so that it leaves its core to a rank measuring steps per second.
 void idle_barrier();
