@@ -124,6 +124,31 @@ TEST(CliMpi, TwoRanksPrintOnceWriteOneFolderAndMatchOneRank) {
   EXPECT_GT(compared, 200);
 }
 
+TEST(CliMpi, EveryVariantIsTimedOnTwoRanksWithTheOneRankStableStep) {
+  const std::string mpirun = find_mpirun();
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";
+  TemporaryDirectory one, two;
+  const std::string timed =
+      std::string(MSFEM_TEST_DATA_DIR) +
+      "/small_sphere.prm --quiet --no-curve --set \"timing/steps=200\" --out ";
+  const auto alone = run_msfem("run " + timed + (one / "run").string());
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const auto shared = run_msfem_on_two_ranks(mpirun, "run " + timed + (two / "run").string());
+  ASSERT_EQ(shared.exit_code, 0) << shared.err;
+  const auto a = nlohmann::json::parse(read_text(one / "run" / "summary.json"));
+  const auto b = nlohmann::json::parse(read_text(two / "run" / "summary.json"));
+  ASSERT_EQ(a["variants"].size(), b["variants"].size());
+  for (std::size_t v = 0; v < b["variants"].size(); ++v) {
+    const auto& x = a["variants"][v];
+    const auto& y = b["variants"][v];
+    EXPECT_GT(y["steps_per_second"].get<double>(), 0.0) << y["name"];
+    // Bisected on the same model from the same equilibrium: the same step, whichever rank timed it.
+    EXPECT_NEAR(y["stable_dt_s"].get<double>(), x["stable_dt_s"].get<double>(),
+                1e-6 * x["stable_dt_s"].get<double>())
+        << y["name"];
+  }
+}
+
 TEST(CliMpi, BadInputOnTwoRanksExitsTwoOnceAndWritesNothing) {
   const std::string mpirun = find_mpirun();
   if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";

@@ -28,7 +28,8 @@ struct Pending {
 };
 
 // This rank's loads of variant v, in increasing order; a solver's failure ends the variant here.
-Pending press_share(const CaseRun& run, int v, const std::vector<double>& path) {
+// The built variant is kept where it is to be timed.
+Pending press_share(const CaseRun& run, int v, const std::vector<double>& path, bool timed) {
   const cases::Variant kind = run.problem.parameters.mass_spring.variants[v];
   Pending p;
   p.built = build_variant(kind, run.problem, run.mesh, run.loads.front().tool);
@@ -49,7 +50,7 @@ Pending press_share(const CaseRun& run, int v, const std::vector<double>& path) 
       break;
     }
   }
-  if (s.load_indices.empty() || s.load_indices.front() != 0) p.built.reset();
+  if (!timed || s.load_indices.empty() || s.load_indices.front() != 0) p.built.reset();
   return p;
 }
 
@@ -84,7 +85,7 @@ std::vector<VariantShare> this_ranks_shares(const CaseRun& run, const std::vecto
       bool any = false;
       for (std::size_t k = 0; k < run.loads.size(); ++k)
         any = any || mine(v, k);
-      if (any) pending.push_back(press_share(run, v, path));
+      if (any) pending.push_back(press_share(run, v, path, settings.time_dynamics));
       progress.advance("variant " + cases::name_of(variants[v]) + " (this rank's loads)", v + 1,
                        total, seconds_since(start));
     }
