@@ -136,10 +136,40 @@ void share_points(std::vector<SweepPoint>& points, const std::vector<bool>& mine
       points[entry.at("item").get<std::size_t>()] = point_from_json(entry.at("point"));
 }
 
+// Which rank times each (variant, integrator) item: the costliest first, each to the rank with the
+// least work so far. A timing costs about the model's nodes times its integrator's price per step
+// (implicit Euler's CG solve some 30-200 explicit steps on the sphere, RK4's four force evaluations
+// 3-7): dealt round-robin, four integrators on two ranks would give one rank every implicit item.
+std::vector<int> owners(
+    const CaseRun& run,
+    const std::vector<std::pair<std::size_t, massspring::IntegratorKind>>& items) {
+  std::vector<double> cost(items.size());
+  for (std::size_t j = 0; j < items.size(); ++j) {
+    const massspring::IntegratorKind k = items[j].second;
+    const double price = k == massspring::IntegratorKind::implicit_euler ? 100.0
+                         : k == massspring::IntegratorKind::rk4          ? 5.0
+                                                                         : 1.0;
+    cost[j] = price * run.variants[items[j].first].nodes;
+  }
+  std::vector<std::size_t> order(items.size());
+  for (std::size_t j = 0; j < order.size(); ++j)
+    order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
+  std::vector<double> work(static_cast<std::size_t>(ranks::count()), 0.0);
+  std::vector<int> owner(items.size(), 0);
+  for (const std::size_t j : order) {
+    const auto least = std::min_element(work.begin(), work.end());
+    owner[j] = static_cast<int>(least - work.begin());
+    *least += cost[j];
+  }
+  return owner;
+}
+
 // One resolution's points with volume preservation as `volume`: every variant that has the
 // setting's model with every integrator (a variant without volume elements is left out of the
 // volume-preserving pass: it would repeat the other's points). The FEM comes from the cache after
-// the first pass. Under mpirun the (variant, integrator) items are dealt round-robin and timed at
+// the first pass. Under mpirun the (variant, integrator) items are dealt out (owners) and timed at
 // the same time, one per rank: each timing is single-threaded on its rank's own core.
 std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
                                          const SweepSettings& settings, bool volume,
@@ -160,8 +190,9 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
         items.emplace_back(v, integrator);
   std::vector<SweepPoint> points(items.size());
   std::vector<bool> mine(items.size());
+  const std::vector<int> owner = owners(run, items);
   for (std::size_t j = 0; j < items.size(); ++j)
-    mine[j] = static_cast<int>(j % static_cast<std::size_t>(ranks::count())) == ranks::index();
+    mine[j] = owner[j] == ranks::index();
   ranks::agree([&] {
     std::optional<std::pair<std::size_t, BuiltVariant>> built;  // the last variant built here
     for (std::size_t j = 0; j < items.size(); ++j) {
