@@ -10,6 +10,7 @@
 #include "msfem/compare/calibration/calibration_case.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
 
 namespace msfem::compare {
@@ -59,6 +60,15 @@ int calibrate_command(const Arguments& args) {
   if (!opt.flag("no-cache")) request.fem_cache_directory = fem_cache_beside(final_dir);
   std::ostringstream printed;
   bool converged = true;
+  // Under mpirun every rank calibrates (the FEM is shared, the fit repeated) and rank 0 writes.
+  const bool writes = ranks::is_root();
+  ranks::agree([&] {
+    if (writes) check_output_folder(final_dir);
+  });
+  if (!writes) {
+    const CaseCalibration c = calibrate_case(parameters, request);
+    return !c.fit.converged && opt.flag("strict") ? 1 : 0;
+  }
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
     const CaseCalibration c = calibrate_case(parameters, request);
     converged = c.fit.converged;

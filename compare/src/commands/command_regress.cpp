@@ -7,6 +7,7 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/pipeline/regression.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
 
@@ -75,6 +76,7 @@ int regress_command(const Arguments& args) {
         fem_cache_beside(std::filesystem::path(parameters.output.directory) / parameters.name);
     const CaseRun run = run_case(parameters, settings);
     if (opt.flag("update")) {
+      if (!ranks::is_root()) continue;  // under mpirun rank 0 alone writes the baseline
       const nlohmann::json old =
           std::filesystem::exists(baseline_file) ? read_baseline(baseline_file) : nlohmann::json();
       const nlohmann::json fresh = write_baseline(run, dir);

@@ -10,6 +10,7 @@
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/run_outputs.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
@@ -32,7 +33,13 @@ int run_command(const Arguments& args) {
   std::ostringstream printed;  // shown once the folder is in place
   std::vector<std::pair<std::string, std::string>> failed;
   std::vector<std::string> buckled;  // "variant: warning", repeated on stderr
-  fill_directory_atomically(final_dir, [&](const std::filesystem::path& work_dir) {
+  // Under mpirun every rank runs the case and rank 0 alone writes; a folder it would refuse is
+  // refused on every rank before any work.
+  const bool writes = ranks::is_root();
+  ranks::agree([&] {
+    if (writes) check_output_folder(final_dir);
+  });
+  const auto run_and_write = [&](const std::filesystem::path* work_dir) {
     RunSettings settings;
     settings.quiet = opt.flag("quiet");
     settings.force_depth_curve = !opt.flag("no-curve");
@@ -40,11 +47,12 @@ int run_command(const Arguments& args) {
     settings.fem_cache_directory = cache;
     const CaseRun run = run_case(parameters, settings);
     failed = run.failed_variants;
+    if (!work_dir) return;
     for (const auto& v : run.variants)
       for (const auto& w : v.warnings)
         if (w.find(buckling_warning_start) != std::string::npos)
           buckled.push_back(v.name + ": " + w);
-    write_run_outputs(run, work_dir);
+    write_run_outputs(run, *work_dir);
     if (opt.flag("json")) {
       printed << summary_json(run).dump(2) << '\n';
     } else {
@@ -54,7 +62,12 @@ int run_command(const Arguments& args) {
               << " s\n"
               << variant_table(run) << "results in " << final_dir.string() << "\n";
     }
-  });
+  };
+  if (writes)
+    fill_directory_atomically(final_dir,
+                              [&](const std::filesystem::path& work) { run_and_write(&work); });
+  else
+    run_and_write(nullptr);
   std::cout << printed.str();
   for (const auto& warning : buckled)
     std::cerr << "msfem run: warning: " << warning << "\n";

@@ -11,6 +11,7 @@
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/pipeline/sweep.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/plots.hpp"
@@ -108,6 +109,15 @@ int sweep_command(const Arguments& args) {
   const std::filesystem::path cache = fem_cache_beside(final_dir);
   std::ostringstream printed;
   std::vector<std::pair<int, std::string>> failed;
+  // Under mpirun every rank sweeps (the FEM and the timed items are shared) and rank 0 writes.
+  const bool writes = ranks::is_root();
+  ranks::agree([&] {
+    if (writes) check_output_folder(final_dir);
+  });
+  if (!writes) {
+    failed = run_sweep(parameters, settings, cache).failed_resolutions;
+    return failed.empty() ? 0 : 1;
+  }
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work) {
     const SweepResult result = run_sweep(parameters, settings, cache);
     const auto& points = result.points;

@@ -8,6 +8,7 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/commands/commands.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 
 namespace {
 
@@ -100,10 +101,8 @@ int finish(const std::string& name, int code) {
   return code;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
+// The command named by args[0]; a failure's line, printed, is kept in `failure`.
+int dispatch(std::vector<std::string> args, std::string& failure) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     print_usage(args.empty() ? stderr : stdout);
     return args.empty() ? 2 : 0;
@@ -116,20 +115,30 @@ int main(int argc, char** argv) {
       std::printf("usage: msfem %s\n", c.usage);
       return finish(name, 0);
     }
+    int code = 1;
     try {
       return finish(name, c.run(args));
     } catch (const msfem::cases::InputError& e) {
-      std::cerr << "msfem " << name << ": error: " << e.what() << '\n';
-      return 2;
+      failure = "msfem " + name + ": error: " + e.what(), code = 2;
     } catch (const std::invalid_argument& e) {
-      std::cerr << "msfem " << name << ": error: " << e.what() << '\n';
-      return 2;
+      failure = "msfem " + name + ": error: " + e.what(), code = 2;
     } catch (const std::exception& e) {
-      std::cerr << "msfem " << name << ": failed: " << e.what() << '\n';
-      return 1;
+      failure = "msfem " + name + ": failed: " + e.what();
     }
+    std::cerr << failure << '\n';
+    return code;
   }
-  std::cerr << "msfem: unknown command '" << name << "'\n";
+  failure = "msfem: unknown command '" + name + "'";
+  std::cerr << failure << '\n';
   print_usage(stderr);
   return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  msfem::compare::ranks::start_if_launched();
+  std::string failure;
+  const int code = dispatch(std::vector<std::string>(argv + 1, argv + argc), failure);
+  return msfem::compare::ranks::finish(code, failure);
 }

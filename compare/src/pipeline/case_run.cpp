@@ -10,7 +10,9 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/pipeline/fem_cache.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
+#include "variant_share.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -168,13 +170,53 @@ ToolLoadVariant compare_at_load(const Problem& problem, const BuiltVariant& buil
   return o;
 }
 
-// The variant pressed along the loading path at one load and measured there.
+}  // namespace
+
+namespace detail {
+
 ToolLoadVariant at_load(const Problem& problem, BuiltVariant& built, const LoadReference& load,
                         const std::vector<double>& path) {
   std::vector<ForceDepthPoint> curve;
   const StaticSolution s = press(built, load.tool, path, &curve);
   return compare_at_load(problem, built, s, std::move(curve), load);
 }
+
+void warn_at_load(const CaseRun& run, long long tetrahedra, std::size_t load, VariantResult& r) {
+  const LoadReference& reference = run.loads[load];
+  const ToolLoadVariant& result = r.loads[load];
+  if (reference.tool)
+    if (auto warning =
+            buckling_warning(result.force_depth, *reference.tool, reference.fem, tetrahedra))
+      r.warnings.push_back((load == 0 ? "" : "at tool " + std::to_string(load) + ": ") + *warning);
+  if (load != 0) return;
+  std::string unresolved;
+  for (const std::string& metric : unresolved_metrics(run, result, load))
+    unresolved += (unresolved.empty() ? "" : ", ") + metric;
+  if (!unresolved.empty())
+    r.warnings.push_back("not resolved by this reference: " + unresolved +
+                         " within 3x of the FEM's own estimated error (a finer fem/cell "
+                         "size resolves it)");
+}
+
+VariantResult variant_header(const BuiltVariant& built) {
+  VariantResult r;
+  r.kind = built.kind;
+  r.name = built.name;
+  r.nodes = built.model->num_nodes();
+  r.springs = built.model->network().num_springs();
+  r.refinement_added_nodes = built.refinement_added_nodes;
+  r.warnings = built.warnings;
+  r.parameters = variant_parameters(*built.model);
+  r.parameters["youngs_modulus_range_pa"] = {built.youngs_modulus_range.min,
+                                             built.youngs_modulus_range.max};
+  return r;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::at_load;
 
 // The variant at loads [first, end) of the run. Two workers (each with its own copy of the
 // network) share them: the statics are independent and a machine with two cores finishes the
@@ -206,48 +248,42 @@ void press_loads(const CaseRun& run, BuiltVariant& built, const std::vector<doub
     if (e) std::rethrow_exception(e);
 }
 
-// The warnings a variant's result at one load raises: buckling under its tool, and at the first
-// load the metrics the reference does not resolve.
-void warn_at_load(const CaseRun& run, const BuiltVariant& built, std::size_t load,
-                  VariantResult& r) {
-  const LoadReference& reference = run.loads[load];
-  const ToolLoadVariant& result = r.loads[load];
-  if (reference.tool)
-    if (auto warning = buckling_warning(result.force_depth, *reference.tool, reference.fem,
-                                        built.tetrahedra.rows()))
-      r.warnings.push_back((load == 0 ? "" : "at tool " + std::to_string(load) + ": ") + *warning);
-  if (load != 0) return;
-  std::string unresolved;
-  for (const std::string& metric : unresolved_metrics(run, result, load))
-    unresolved += (unresolved.empty() ? "" : ", ") + metric;
-  if (!unresolved.empty())
-    r.warnings.push_back("not resolved by this reference: " + unresolved +
-                         " within 3x of the FEM's own estimated error (a finer fem/cell "
-                         "size resolves it)");
-}
-
 // One variant on the run's problem: pressed along the loading path at every load, compared with
 // the FEM, timed from its equilibrium at the first, with its warnings.
 VariantResult run_variant(const CaseRun& run, BuiltVariant& built, const std::vector<double>& path,
                           const RunSettings& settings) {
-  VariantResult r;
-  r.kind = built.kind;
-  r.name = built.name;
-  r.nodes = built.model->num_nodes();
-  r.springs = built.model->network().num_springs();
-  r.refinement_added_nodes = built.refinement_added_nodes;
-  r.warnings = built.warnings;
-  r.parameters = variant_parameters(*built.model);
-  r.parameters["youngs_modulus_range_pa"] = {built.youngs_modulus_range.min,
-                                             built.youngs_modulus_range.max};
+  VariantResult r = detail::variant_header(built);
   // The first load on the variant itself: the timing starts from its equilibrium, pressed there.
   r.loads.push_back(at_load(run.problem, built, run.loads.front(), path));
   if (settings.time_dynamics)
     r.timing = time_variant(built, run.problem.parameters.timing, r.loads.front().equilibrium);
   press_loads(run, built, path, 1, r.loads);
   for (std::size_t load = 0; load < r.loads.size(); ++load)
-    warn_at_load(run, built, load, r);
+    detail::warn_at_load(run, built.tetrahedra.rows(), load, r);
   return r;
+}
+
+// Every variant of the case on this process, one after another.
+void run_variants(CaseRun& run, const std::vector<double>& path, const RunSettings& settings,
+                  const Progress& progress) {
+  const auto start = Clock::now();
+  const auto& variants = run.problem.parameters.mass_spring.variants;
+  const int total = static_cast<int>(variants.size());
+  for (int i = 0; i < total; ++i) {
+    const std::string name = cases::name_of(variants[i]);
+    BuiltVariant built = build_variant(variants[i], run.problem, run.mesh, run.loads.front().tool);
+    try {
+      VariantResult r = run_variant(run, built, path, settings);
+      run.variants.push_back(std::move(r));
+    } catch (const cases::InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      // One variant's Newton or time stepping failing must not cost the others' results.
+      run.failed_variants.emplace_back(name, e.what());
+      progress.stage("variant " + name + " failed: " + e.what());
+    }
+    progress.advance("variant " + name, i + 1, total, seconds_since(start));
+  }
 }
 
 }  // namespace
@@ -347,8 +383,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   CaseRun run;
   progress.stage("loading the surface and placing supports and loads");
   run.problem = make_problem(parameters);
-  const Problem& problem = run.problem;
-  check_variants_fit(problem);
+  check_variants_fit(run.problem);
   reference_at_every_load(run, settings, progress);
   const std::optional<ToolPlacement>& tool = run.loads.front().tool;
 
@@ -358,24 +393,10 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
       tool ? loading_path(curve_depths(parameters.loads.tool), tool->depth,
                           parameters.loads.tool.path_step_m)
            : std::vector<double>{};
-  const auto variants_start = Clock::now();
-  const int total = static_cast<int>(parameters.mass_spring.variants.size());
-  for (int i = 0; i < total; ++i) {
-    const cases::Variant kind = parameters.mass_spring.variants[i];
-    const std::string name = cases::name_of(kind);
-    BuiltVariant built = build_variant(kind, problem, run.mesh, tool);
-    try {
-      VariantResult r = run_variant(run, built, path, settings);
-      run.variants.push_back(std::move(r));
-    } catch (const cases::InputError&) {
-      throw;
-    } catch (const std::runtime_error& e) {
-      // One variant's Newton or time stepping failing must not cost the others' results.
-      run.failed_variants.emplace_back(name, e.what());
-      progress.stage("variant " + name + " failed: " + e.what());
-    }
-    progress.advance("variant " + name, i + 1, total, seconds_since(variants_start));
-  }
+  if (ranks::count() > 1)
+    detail::run_variants_across_ranks(run, path, settings, progress);
+  else
+    run_variants(run, path, settings, progress);
   if (!settings.force_depth_curve)
     for (auto& v : run.variants)
       for (auto& load : v.loads)

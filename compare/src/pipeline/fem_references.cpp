@@ -4,6 +4,7 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/pipeline/fem_cache.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 
 namespace msfem::compare {
@@ -35,6 +36,9 @@ std::vector<std::optional<FemCacheEntry>> cached_entries(FemReferences& r,
   if (!request.cache_directory) return cached;
   for (std::size_t i = 0; i < r.loads.size(); ++i) {
     cached[i] = load_fem_cache(*request.cache_directory, r.loads[i].cache_key);
+    // The ranks solve together, so a load is taken from the cache only where every rank's cache
+    // (each node's own disk on a cluster) holds it.
+    if (!ranks::on_every_rank(cached[i].has_value())) cached[i].reset();
     if (cached[i] && r.mesh.num_tetrahedra() == 0) r.mesh = cached[i]->mesh;
   }
   return cached;

@@ -12,6 +12,7 @@
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
+#include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/writers/json_values.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 
@@ -42,14 +43,137 @@ cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
   return p;
 }
 
+// Variant `v` of the run with one integrator, timed at half that integrator's stable step.
+SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVariant& built,
+                       massspring::IntegratorKind integrator, int resolution) {
+  const LoadReference& load = run.loads.front();
+  const ToolLoadVariant& at_load = v.loads.front();
+  cases::TimingParameters timing = run.problem.parameters.timing;
+  timing.integrator = integrator;
+  timing.dt_s = 0.0;  // each integrator at half its own stable step
+  // From run_case's equilibrium, reached from rest as here.
+  const Timing t = time_variant(built, timing, at_load.equilibrium, /*measure_settling=*/false);
+  SweepPoint pt;
+  pt.variant = v.name;
+  pt.integrator = massspring::to_string(integrator);
+  pt.stepper = t.stepper;
+  pt.volume_preservation = v.parameters.contains("volume_preservation");
+  pt.resolution = resolution;
+  pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
+  pt.nodes = v.nodes;
+  pt.springs = v.springs;
+  pt.rel_l2_error = at_load.errors.all.rel_l2_error;
+  pt.reaction_force_rel_error = at_load.reaction_force_rel_error;
+  pt.stable_dt_s = t.stable_dt_s;
+  pt.steps_per_second = t.steps_per_second;
+  pt.realtime_factor = t.realtime_factor;
+  pt.dt_s = t.dt_s;
+  pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
+  pt.fem_estimated_rel_l2_error = load.fem_error.rel_l2_error;
+  pt.fem_estimated_force_rel_error = load.fem_error.force_rel_error;
+  pt.not_resolved_by_reference = unresolved_metrics(run, at_load, 0);
+  return pt;
+}
+
+nlohmann::json point_json(const SweepPoint& p) {
+  return {{"variant", p.variant},
+          {"volume_preservation", p.volume_preservation},
+          {"integrator", p.integrator},
+          {"stepper", p.stepper},
+          {"resolution", p.resolution},
+          {"surface_vertices", p.surface_vertices},
+          {"nodes", p.nodes},
+          {"springs", p.springs},
+          {"rel_l2_error", p.rel_l2_error},
+          {"reaction_force_rel_error", p.reaction_force_rel_error},
+          {"stable_dt_s", p.stable_dt_s},
+          {"steps_per_second", p.steps_per_second},
+          {"realtime_factor", p.realtime_factor},
+          {"dt_s", p.dt_s},
+          {"ms_per_60hz_frame", p.ms_per_60hz_frame},
+          {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
+          {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
+          {"not_resolved_by_reference", p.not_resolved_by_reference}};
+}
+
+std::optional<double> optional_number(const nlohmann::json& j) {
+  return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
+}
+
+SweepPoint point_from_json(const nlohmann::json& j) {
+  SweepPoint p;
+  j.at("variant").get_to(p.variant);
+  j.at("volume_preservation").get_to(p.volume_preservation);
+  j.at("integrator").get_to(p.integrator);
+  j.at("stepper").get_to(p.stepper);
+  for (auto [key, to] : {std::pair{"resolution", &p.resolution},
+                         {"surface_vertices", &p.surface_vertices},
+                         {"nodes", &p.nodes},
+                         {"springs", &p.springs}})
+    j.at(key).get_to(*to);
+  for (auto [key, to] : {std::pair{"rel_l2_error", &p.rel_l2_error},
+                         {"reaction_force_rel_error", &p.reaction_force_rel_error},
+                         {"stable_dt_s", &p.stable_dt_s},
+                         {"steps_per_second", &p.steps_per_second},
+                         {"realtime_factor", &p.realtime_factor},
+                         {"dt_s", &p.dt_s},
+                         {"ms_per_60hz_frame", &p.ms_per_60hz_frame}})
+    j.at(key).get_to(*to);
+  p.fem_estimated_rel_l2_error = optional_number(j.at("fem_estimated_rel_l2_error"));
+  p.fem_estimated_force_rel_error = optional_number(j.at("fem_estimated_force_rel_error"));
+  j.at("not_resolved_by_reference").get_to(p.not_resolved_by_reference);
+  return p;
+}
+
+// Under mpirun each rank timed the items it owns; every rank gets all of them, in item order.
+void share_points(std::vector<SweepPoint>& points, const std::vector<bool>& mine) {
+  nlohmann::json own = nlohmann::json::array();
+  for (std::size_t j = 0; j < points.size(); ++j)
+    if (mine[j]) own.push_back({{"item", j}, {"point", point_json(points[j])}});
+  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(own);
+  for (const std::string& part : ranks::gather_on_all(std::string(bytes.begin(), bytes.end())))
+    for (const auto& entry : nlohmann::json::from_cbor(part))
+      points[entry.at("item").get<std::size_t>()] = point_from_json(entry.at("point"));
+}
+
+// Which rank times each (variant, integrator) item: the costliest first, each to the rank with the
+// least work so far. A timing costs about the model's nodes times its integrator's price per step
+// (implicit Euler's CG solve some 30-200 explicit steps on the sphere, RK4's four force evaluations
+// 3-7): dealt round-robin, four integrators on two ranks would give one rank every implicit item.
+std::vector<int> owners(
+    const CaseRun& run,
+    const std::vector<std::pair<std::size_t, massspring::IntegratorKind>>& items) {
+  std::vector<double> cost(items.size());
+  for (std::size_t j = 0; j < items.size(); ++j) {
+    const massspring::IntegratorKind k = items[j].second;
+    const double price = k == massspring::IntegratorKind::implicit_euler ? 100.0
+                         : k == massspring::IntegratorKind::rk4          ? 5.0
+                                                                         : 1.0;
+    cost[j] = price * run.variants[items[j].first].nodes;
+  }
+  std::vector<std::size_t> order(items.size());
+  for (std::size_t j = 0; j < order.size(); ++j)
+    order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
+  std::vector<double> work(static_cast<std::size_t>(ranks::count()), 0.0);
+  std::vector<int> owner(items.size(), 0);
+  for (const std::size_t j : order) {
+    const auto least = std::min_element(work.begin(), work.end());
+    owner[j] = static_cast<int>(least - work.begin());
+    *least += cost[j];
+  }
+  return owner;
+}
+
 // One resolution's points with volume preservation as `volume`: every variant that has the
 // setting's model with every integrator (a variant without volume elements is left out of the
 // volume-preserving pass: it would repeat the other's points). The FEM comes from the cache after
-// the first pass.
+// the first pass. Under mpirun the (variant, integrator) items are dealt out (owners) and timed at
+// the same time, one per rank: each timing is single-threaded on its rank's own core.
 std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
                                          const SweepSettings& settings, bool volume,
                                          const std::filesystem::path& fem_cache_directory) {
-  std::vector<SweepPoint> points;
   cases::CaseParameters p = at_resolution(parameters, resolution);
   p.mass_spring.volume_preservation = volume;
   RunSettings run_settings;
@@ -59,40 +183,28 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
   run_settings.all_tools = false;  // accuracy against speed at the case's first tool
   run_settings.fem_cache_directory = fem_cache_directory;
   const CaseRun run = run_case(p, run_settings);
-  const LoadReference& load = run.loads.front();
-  for (const auto& v : run.variants) {
-    const bool has_volume = v.parameters.contains("volume_preservation");
-    if (volume && !has_volume) continue;
-    const BuiltVariant built = build_variant(v.kind, run.problem, run.mesh, load.tool);
-    const ToolLoadVariant& at_load = v.loads.front();
-    const Eigen::VectorXd& equilibrium = at_load.equilibrium;  // run_case's, from rest as here
-    for (const auto& integrator : settings.integrators) {
-      cases::TimingParameters timing = p.timing;
-      timing.integrator = integrator;
-      timing.dt_s = 0.0;  // each integrator at half its own stable step
-      const Timing t = time_variant(built, timing, equilibrium, /*measure_settling=*/false);
-      SweepPoint pt;
-      pt.variant = v.name;
-      pt.integrator = massspring::to_string(integrator);
-      pt.stepper = t.stepper;
-      pt.volume_preservation = has_volume;
-      pt.resolution = resolution;
-      pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
-      pt.nodes = v.nodes;
-      pt.springs = v.springs;
-      pt.rel_l2_error = at_load.errors.all.rel_l2_error;
-      pt.reaction_force_rel_error = at_load.reaction_force_rel_error;
-      pt.stable_dt_s = t.stable_dt_s;
-      pt.steps_per_second = t.steps_per_second;
-      pt.realtime_factor = t.realtime_factor;
-      pt.dt_s = t.dt_s;
-      pt.ms_per_60hz_frame = t.ms_per_60hz_frame;
-      pt.fem_estimated_rel_l2_error = load.fem_error.rel_l2_error;
-      pt.fem_estimated_force_rel_error = load.fem_error.force_rel_error;
-      pt.not_resolved_by_reference = unresolved_metrics(run, at_load, 0);
-      points.push_back(pt);
+  std::vector<std::pair<std::size_t, massspring::IntegratorKind>> items;
+  for (std::size_t v = 0; v < run.variants.size(); ++v)
+    if (!volume || run.variants[v].parameters.contains("volume_preservation"))
+      for (const auto& integrator : settings.integrators)
+        items.emplace_back(v, integrator);
+  std::vector<SweepPoint> points(items.size());
+  std::vector<bool> mine(items.size());
+  const std::vector<int> owner = owners(run, items);
+  for (std::size_t j = 0; j < items.size(); ++j)
+    mine[j] = owner[j] == ranks::index();
+  ranks::agree([&] {
+    std::optional<std::pair<std::size_t, BuiltVariant>> built;  // the last variant built here
+    for (std::size_t j = 0; j < items.size(); ++j) {
+      if (!mine[j]) continue;
+      const VariantResult& v = run.variants[items[j].first];
+      if (!built || built->first != items[j].first)
+        built.emplace(items[j].first,
+                      build_variant(v.kind, run.problem, run.mesh, run.loads.front().tool));
+      points[j] = timed_point(run, v, built->second, items[j].second, resolution);
     }
-  }
+  });
+  if (ranks::count() > 1) share_points(points, mine);
   return points;
 }
 
@@ -139,25 +251,7 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
 nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& p : result.points)
-    list.push_back(
-        {{"variant", p.variant},
-         {"volume_preservation", p.volume_preservation},
-         {"integrator", p.integrator},
-         {"stepper", p.stepper},
-         {"resolution", p.resolution},
-         {"surface_vertices", p.surface_vertices},
-         {"nodes", p.nodes},
-         {"springs", p.springs},
-         {"rel_l2_error", p.rel_l2_error},
-         {"reaction_force_rel_error", p.reaction_force_rel_error},
-         {"stable_dt_s", p.stable_dt_s},
-         {"steps_per_second", p.steps_per_second},
-         {"realtime_factor", p.realtime_factor},
-         {"dt_s", p.dt_s},
-         {"ms_per_60hz_frame", p.ms_per_60hz_frame},
-         {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
-         {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
-         {"not_resolved_by_reference", p.not_resolved_by_reference}});
+    list.push_back(point_json(p));
   nlohmann::json failed = nlohmann::json::array();
   for (const auto& [resolution, why] : result.failed_resolutions)
     failed.push_back({{"resolution", resolution}, {"error", why}});

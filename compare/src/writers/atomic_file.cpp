@@ -121,11 +121,15 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
   });
 }
 
-void fill_directory_atomically(const fs::path& directory,
-                               const std::function<void(const fs::path& work)>& fill) {
+void check_output_folder(const fs::path& directory) {
   if (directory.empty()) throw cases::InputError("the output folder is an empty path");
   if (fs::exists(directory) && !(fs::is_directory(directory) && fs::is_empty(directory)))
     throw cases::InputError(directory.string() + ": output folder exists and is not empty");
+}
+
+void fill_directory_atomically(const fs::path& directory,
+                               const std::function<void(const fs::path& work)>& fill) {
+  check_output_folder(directory);
   const fs::path work = temporary_name_for(directory);
   const PendingTemporary pending(work);
   std::error_code created;

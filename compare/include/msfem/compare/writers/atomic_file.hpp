@@ -20,6 +20,10 @@ void write_file_atomically(
 /// write_file_atomically for a text: the whole of `text`, flushed and checked before the rename.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
 
+/// Throws cases::InputError if `directory` is empty or exists and is not empty (what
+/// fill_directory_atomically refuses before it starts).
+void check_output_folder(const std::filesystem::path& directory);
+
 /// Creates `directory` with everything `fill` writes into the temporary folder it is given, renamed
 /// into place only when `fill` returns: a failed run leaves no folder behind. Throws
 /// cases::InputError, before `fill` runs, if `directory` is empty, exists and is not empty, or its

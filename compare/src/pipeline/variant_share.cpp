@@ -1,0 +1,183 @@
+// A variant's share as bytes: a plain little packer (both ends are the same program on the same
+// kind of machine, so values travel in their native representation), doubles bit for bit so that
+// rank 0 writes exactly what the rank that computed them had.
+#include "variant_share.hpp"
+
+#include <cstring>
+#include <stdexcept>
+#include <type_traits>
+
+namespace msfem::compare::detail {
+namespace {
+
+class Packer {
+ public:
+  template <typename T>
+  std::enable_if_t<std::is_arithmetic_v<T>> put(T value) {
+    bytes_.append(reinterpret_cast<const char*>(&value), sizeof value);
+  }
+  void put(const std::string& s) {
+    put(static_cast<long long>(s.size()));
+    bytes_ += s;
+  }
+  template <typename Derived>
+  void put(const Eigen::PlainObjectBase<Derived>& m) {
+    put(static_cast<long long>(m.rows()));
+    put(static_cast<long long>(m.cols()));
+    bytes_.append(reinterpret_cast<const char*>(m.data()),
+                  sizeof(typename Derived::Scalar) * static_cast<std::size_t>(m.size()));
+  }
+  template <typename T>
+  void put(const std::optional<T>& o) {
+    put(static_cast<char>(o.has_value()));
+    if (o) put(*o);
+  }
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+class Unpacker {
+ public:
+  explicit Unpacker(const std::string& bytes) : bytes_(bytes) {}
+  template <typename T>
+  std::enable_if_t<std::is_arithmetic_v<T>> get(T& value) {
+    take(&value, sizeof value);
+  }
+  void get(std::string& s) {
+    long long n = 0;
+    get(n);
+    s.resize(static_cast<std::size_t>(n));
+    take(s.data(), s.size());
+  }
+  template <typename Derived>
+  void get(Eigen::PlainObjectBase<Derived>& m) {
+    long long rows = 0, cols = 0;
+    get(rows);
+    get(cols);
+    m.resize(rows, cols);
+    take(m.data(), sizeof(typename Derived::Scalar) * static_cast<std::size_t>(m.size()));
+  }
+  template <typename T>
+  void get(std::optional<T>& o) {
+    char present = 0;
+    get(present);
+    o.reset();
+    if (!present) return;
+    o.emplace();
+    get(*o);
+  }
+  bool done() const { return at_ == bytes_.size(); }
+
+ private:
+  void take(void* to, std::size_t n) {
+    if (n > bytes_.size() - at_) throw std::runtime_error("a rank's variant results are truncated");
+    std::memcpy(to, bytes_.data() + at_, n);
+    at_ += n;
+  }
+  const std::string& bytes_;
+  std::size_t at_ = 0;
+};
+
+// One function per structure for both directions, so that a field cannot be written and not read.
+template <typename Io, typename M>
+void fields(Io& io, M& m) {  // ErrorMetrics
+  io.io(m.rel_l2_error), io.io(m.rms_error_m), io.io(m.max_error_m);
+  io.io(m.mean_error_over_max_disp), io.io(m.vertices);
+}
+
+struct Writer {
+  Packer p;
+  template <typename T>
+  void io(const T& v) {
+    p.put(v);
+  }
+};
+struct Reader {
+  Unpacker u;
+  template <typename T>
+  void io(T& v) {
+    u.get(v);
+  }
+};
+
+template <typename Io, typename Curve>
+void curve_fields(Io& io, Curve& curve) {
+  long long n = static_cast<long long>(curve.size());
+  io.io(n);
+  curve.resize(static_cast<std::size_t>(n));
+  // A spring variant's curve has no FEM contact report (only the reference's does).
+  for (auto& point : curve)
+    io.io(point.depth_m), io.io(point.force_n), io.io(point.inverted_elements);
+}
+
+template <typename Io, typename L>
+void load_fields(Io& io, L& o) {  // ToolLoadVariant (kind and name come from the variant)
+  fields(io, o.errors.all), fields(io, o.errors.contact_zone), fields(io, o.errors.far_field);
+  io.io(o.tool_force), io.io(o.reaction_force_rel_error), io.io(o.volume_change);
+  io.io(o.inverted_elements);
+  curve_fields(io, o.force_depth);
+  io.io(o.force_depth_monotone), io.io(o.patch_mean_displacement);
+  io.io(o.patch_displacement_rel_error), io.io(o.newton_iterations);
+  io.io(o.equilibrium), io.io(o.surface_displacement), io.io(o.error);
+}
+
+template <typename Io, typename T>
+void timing_fields(Io& io, T& t) {
+  io.io(t.integrator), io.io(t.stepper), io.io(t.dt_s), io.io(t.steps_per_second);
+  io.io(t.stable_dt_s), io.io(t.predicted_stable_dt_s), io.io(t.realtime_factor);
+  io.io(t.settle_time_s), io.io(t.settled), io.io(t.ms_per_60hz_frame);
+}
+
+template <typename Io, typename S>
+void share_fields(Io& io, S& s) {
+  io.io(s.variant), io.io(s.timed), io.io(s.tetrahedra), io.io(s.failure_order), io.io(s.failure);
+  VariantResult& r = s.result;
+  int kind = static_cast<int>(r.kind);
+  io.io(kind);
+  r.kind = static_cast<cases::Variant>(kind);
+  io.io(r.name), io.io(r.nodes), io.io(r.springs), io.io(r.refinement_added_nodes);
+  timing_fields(io, r.timing);
+  std::string parameters = r.parameters.dump();
+  io.io(parameters);
+  if constexpr (std::is_same_v<Io, Reader>) r.parameters = nlohmann::json::parse(parameters);
+  long long n = static_cast<long long>(r.warnings.size());
+  io.io(n);
+  r.warnings.resize(static_cast<std::size_t>(n));
+  for (auto& w : r.warnings)
+    io.io(w);
+  n = static_cast<long long>(s.load_indices.size());
+  io.io(n);
+  s.load_indices.resize(static_cast<std::size_t>(n));
+  r.loads.resize(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < s.load_indices.size(); ++i) {
+    io.io(s.load_indices[i]);
+    r.loads[i].kind = r.kind;
+    r.loads[i].name = r.name;
+    load_fields(io, r.loads[i]);
+  }
+}
+
+}  // namespace
+
+std::string to_bytes(std::vector<VariantShare> shares) {
+  Writer w;
+  w.io(static_cast<long long>(shares.size()));
+  for (VariantShare& s : shares)
+    share_fields(w, s);
+  return w.p.bytes();
+}
+
+std::vector<VariantShare> shares_from_bytes(const std::string& bytes) {
+  Reader r{Unpacker(bytes)};
+  long long n = 0;
+  r.io(n);
+  std::vector<VariantShare> shares(static_cast<std::size_t>(n));
+  for (VariantShare& s : shares)
+    share_fields(r, s);
+  if (!r.u.done()) throw std::runtime_error("a rank's variant results have bytes left over");
+  return shares;
+}
+
+}  // namespace msfem::compare::detail
