@@ -211,8 +211,8 @@ TEST(CaseSettings, EveryIntegratorIsTheOneTimed) {
     }
     // On the code a simulator runs: the fast kernels for the schemes they have.
     using K = massspring::IntegratorKind;
-    const bool fast_explicit = kind == K::symplectic_euler || kind == K::central_difference ||
-                               kind == K::explicit_euler;
+    const bool fast_explicit =
+        kind == K::symplectic_euler || kind == K::central_difference || kind == K::explicit_euler;
     EXPECT_EQ(t.stepper, fast_explicit               ? "fast_explicit"
                          : kind == K::implicit_euler ? "fast_implicit"
                                                      : "generic")
