@@ -16,12 +16,14 @@ std::string point_text(const Eigen::Vector3d& x) {
 }
 
 // E_0 / E(x): dividing E_0 by E (not E by E_0) keeps a field equal to E_0 an exact 1.
+// `what` and `index` name the item in the message (built only when it is thrown).
 double inverse_ratio(const ModulusField& field, const Eigen::Vector3d& x, double built_modulus,
-                     const std::string& where, ModulusRange& range) {
+                     const char* what, int index, ModulusRange& range) {
   const double e = field(x);
   if (!(e > 0.0) || !std::isfinite(e))
     throw ModelError("Young's modulus field gives " + std::to_string(e) + " Pa at " +
-                     point_text(x) + " (" + where + "); it must be finite and > 0");
+                     point_text(x) + " (" + what + " " + std::to_string(index) +
+                     "); it must be finite and > 0");
   range.include(e);
   return built_modulus / e;
 }
@@ -52,17 +54,15 @@ ModulusRange apply_modulus_field(SpringNetwork& network, const ModulusField& fie
   for (int s = 0; s < network.num_springs(); ++s) {
     const Eigen::Vector3d a = network.rest_positions.row(network.springs(s, 0)).transpose();
     const Eigen::Vector3d b = network.rest_positions.row(network.springs(s, 1)).transpose();
-    const std::string where = "spring " + std::to_string(s);
     double compliance = 0.0;  // Σ E_0 / E over the pieces
     for (int i = 0; i < samples; ++i)
-      compliance +=
-          inverse_ratio(field, a + (b - a) * ((i + 0.5) / samples), built_modulus, where, range);
+      compliance += inverse_ratio(field, a + (b - a) * ((i + 0.5) / samples), built_modulus,
+                                  "spring", s, range);
     network.stiffness[s] *= double(samples) / compliance;
   }
   for (int n = 0; n < network.num_anchors(); ++n) {
     const Eigen::Vector3d x = network.anchor_point.row(n).transpose();
-    network.anchor_stiffness[n] /=
-        inverse_ratio(field, x, built_modulus, "anchor " + std::to_string(n), range);
+    network.anchor_stiffness[n] /= inverse_ratio(field, x, built_modulus, "anchor", n, range);
   }
   return range;
 }
@@ -82,8 +82,8 @@ ModulusRange apply_modulus_field(VolumeElements& elements, const Eigen::MatrixX3
                                          .dot(corners[3] - corners[0])) *
                             elements.tet_weight[t];
       const Eigen::Vector3d centroid = (corners[0] + corners[1] + corners[2] + corners[3]) / 4.0;
-      weighted += volume / inverse_ratio(field, centroid, built_modulus,
-                                         "volume element " + std::to_string(e), range);
+      weighted +=
+          volume / inverse_ratio(field, centroid, built_modulus, "volume element", e, range);
       weights += volume;
     }
     if (weights > 0.0) elements.modulus[e] *= weighted / weights;

@@ -10,6 +10,7 @@
 #include "msfem/compare/writers/json_values.hpp"
 #include "msfem/compare/writers/plots.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
+#include "msfem/compare/writers/text_format.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -50,12 +51,6 @@ double mean_of(const std::vector<LoadErrors>& errors, double LoadErrors::*field)
   for (const auto& e : errors)
     sum += e.*field;
   return errors.empty() ? 0.0 : sum / static_cast<double>(errors.size());
-}
-
-std::string fmt(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
 }
 
 std::string loads_table(const CaseCalibration& c) {

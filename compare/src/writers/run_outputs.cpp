@@ -11,6 +11,7 @@
 #include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/fields_h5.hpp"
 #include "msfem/compare/writers/plots.hpp"
+#include "msfem/compare/writers/text_format.hpp"
 #include "msfem/compare/writers/vtu.hpp"
 #include "msfem/fem_reference/elasticity_problem.hpp"
 
@@ -154,12 +155,6 @@ std::string steppers_timed(const CaseRun& run) {
   for (const auto& [stepper, names] : groups)
     text += (text.empty() ? "" : "; ") + std::string("`") + stepper + "` (" + names + ")";
   return text.empty() ? "no stepper (not timed)" : text;
-}
-
-std::string fmt(const char* format, double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
 }
 
 // The E each model saw: constant, or the image's field through the HU table.
