@@ -217,8 +217,8 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
   const bool fields = !model.fields().empty();
   if (fields)
     result.notes.push_back(
-        "naive and implicit not run: the naive loop and the fast implicit stepper step springs "
-        "only; the fast explicit stepper steps the force fields on its calling thread");
+        "naive not run: the naive loop steps springs only; the fast steppers share the force "
+        "fields among their threads");
 
   if (options.run_naive && !fields) {
     NaiveAosStepper naive(model, start);
@@ -231,7 +231,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
     result.naive_steps_per_second = result.naive_spread.median;
   }
 
-  if (options.run_implicit && !fields) {
+  if (options.run_implicit) {
     FastImplicitOptions implicit_options;
     implicit_options.threads = options.threads;
     implicit_options.cg_tolerance = options.implicit_cg_tolerance;

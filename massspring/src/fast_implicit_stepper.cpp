@@ -9,6 +9,7 @@
 
 #include "adaptive_threads.hpp"
 #include "gather_kernels.hpp"
+#include "implicit_fields.hpp"
 #include "soa_layout.hpp"
 #include "thread_team.hpp"
 
@@ -43,7 +44,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         gather_(soa_),
         records_(kRecord * (soa_.num_nodes + 2)),
         p_records_(detail::kDirection * (soa_.num_nodes + 2)),
-        dv_records_(detail::kDirection * (soa_.num_nodes + 2)) {
+        dv_records_(detail::kDirection * (soa_.num_nodes + 2)),
+        fields_(soa_, gather_, team_.size()) {
     const std::size_t lanes = gather_.lane_node.size();
     system_.resize(gather_.chunk_slot.back(), lanes);
     for (int c = 0; c < 3; ++c)
@@ -61,6 +63,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       inverse_block_[e].assign(lanes, Real(0));
       cg_.inverse_block[e] = inverse_block_[e].data();
     }
+    take_fields(model);
     // Equal shares of the layout's blocks of chunks (about equal slot counts).
     for (int m = 0; m <= team_.size(); ++m)
       member_block_.push_back(static_cast<int>(static_cast<long>(blocks()) * m / team_.size()));
@@ -74,6 +77,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     soa_.load_parameters(model);
     gather_.load_parameters(soa_);
     model_ = &model;
+    take_fields(model);
     pack();
   }
   void set_state(const State& state) override {
@@ -126,6 +130,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       };
       // One pass: linearise, and start CG from the warm start (the last step's Δv, cg_advance).
       double sums[3];  // r·u, r·r, b·b; the barrier also completes the u records
+      if (!fields_.empty()) fields_.gather_state(b0, b1, records_.data(), dv_records_.data(), h);
       reduced(
           [&](int c0, int c1, double* out) {
             double local[3];
@@ -134,17 +139,29 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
             std::copy(local, local + 3, out);
           },
           sums);
+      if (!fields_.empty()) {
+        fields_.start_part(member, members, dt);
+        if (members > 1) team_.barrier();
+        fields_.start_apply(b0, b1, members, cg_, p_records_.data(), dt);
+        reduced([&](int c0, int c1, double* out) { start_sums(c0, c1, out); }, sums);
+      }
       double gamma = sums[0], rr = sums[1], alpha = 0.0, previous_gamma = 0.0;
       const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
       int iteration = 0;
       while (iteration < options_.cg_max_iterations && rr > target) {
         double delta[3];  // u·A u
+        if (!fields_.empty()) fields_.gather_direction(b0, b1, p_records_.data(), dt);
         reduced(
             [&](int c0, int c1, double* out) {
               out[0] = kernels_.product(gather_, system_, p_records_.data(), cg_.p, cg_.y, c0, c1);
               out[1] = out[2] = 0.0;
             },
             delta);
+        if (!fields_.empty()) {
+          fields_.product_part(member, members);
+          if (members > 1) team_.barrier();
+          delta[0] += fields_.product_apply(b0, b1, members, cg_, dt);
+        }
         // Chronopoulos-Gear: d·A d = δ - β γ / α_previous, so one reduction per product.
         const double beta = iteration == 0 ? 0.0 : gamma / previous_gamma;
         const double curvature = iteration == 0 ? delta[0] : delta[0] - beta * gamma / alpha;
@@ -184,6 +201,31 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
  private:
   int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
 
+  // The fields and the right-hand side vector they add to (kept by the linearising pass only
+  // then: it costs a model without fields a store per lane).
+  void take_fields(const MassSpringModel& model) {
+    fields_.take(model);
+    const std::size_t lanes = gather_.lane_node.size();
+    for (int c = 0; c < 3; ++c) {
+      rhs_[c].assign(fields_.empty() ? 0 : lanes, Real(0));
+      cg_.b[c] = fields_.empty() ? nullptr : rhs_[c].data();
+    }
+  }
+
+  // r·u, r·r and b·b over the lanes of chunks [c0, c1), once the fields have changed r and u.
+  void start_sums(int c0, int c1, double* out) const {
+    double sums[3] = {0.0, 0.0, 0.0};
+    for (std::size_t lane = static_cast<std::size_t>(c0) * W;
+         lane < static_cast<std::size_t>(c1) * W; ++lane)
+      for (int c = 0; c < 3; ++c) {
+        const double r = cg_.r[c][lane], b = cg_.b[c][lane];
+        sums[0] += r * cg_.p[c][lane];
+        sums[1] += r * r;
+        sums[2] += b * b;
+      }
+    std::copy(sums, sums + 3, out);
+  }
+
   // The node records from the layout's arrays. The Δv records keep Δv for the next warm start
   // (zero at construction, as Δv is).
   void pack() {
@@ -215,6 +257,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::AlignedVector<Real> p_records_;   // u = B⁻¹ r per node (zero on constrained nodes)
   detail::AlignedVector<Real> dv_records_;  // the last step's Δv per node (zero on constrained)
   detail::ImplicitCoefficients<Real> system_;
+  detail::ImplicitFields<Real, W> fields_;
+  detail::AlignedVector<Real> rhs_[3];  // b in lane order, with fields only
   // CG vectors in lane order: Δv, r, u = B⁻¹ r, w = A u, the direction d and s = A d.
   detail::AlignedVector<Real> dv_[3], residual_[3], u_[3], w_[3], direction_[3],
       direction_product_[3];
@@ -232,11 +276,6 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 
 FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
                                          const FastImplicitOptions& options) {
-  // Its kernels know springs, anchors, gravity and loads only: dropping a force field silently
-  // would step another model than the one given.
-  if (!model.fields().empty())
-    throw ModelError("fast implicit stepper: its kernels do not step the model's force fields (" +
-                     model.field_names() + "); use Integrator");
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
   if (options.single_precision &&
       detail::preferred_lanes<float>(true, model.network().num_springs(), model.num_nodes()) == 16)

@@ -8,6 +8,22 @@ std::shared_ptr<const ForceField> ForceField::scaled(const std::string& group, d
   throw ModelError("force field: no coefficient group '" + group + "' to scale");
 }
 
+void ForceField::add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd& v, double cx,
+                                     double cv, std::vector<Eigen::Matrix3d>& blocks,
+                                     Linearisation mode) const {
+  Triplets dfdx_terms, dfdv_terms;
+  add_dfdx_triplets(x, v, dfdx_terms, mode);
+  add_dfdv_triplets(x, dfdv_terms);
+  auto add = [&](const Triplets& terms, double scale) {
+    for (const auto& t : terms)
+      if (t.row() / 3 == t.col() / 3)
+        blocks[static_cast<std::size_t>(t.row() / 3)](t.row() % 3, t.col() % 3) +=
+            scale * t.value();
+  };
+  add(dfdx_terms, cx);
+  add(dfdv_terms, cv);
+}
+
 Eigen::VectorXd ForceModel::force(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
   add_force(x, v, f);

@@ -201,6 +201,8 @@ struct ImplicitCoefficients {
 template <class Real>
 struct CgVectors {
   Real *dv[3], *r[3], *p[3], *y[3], *inverse_block[6];
+  Real* b[3] = {nullptr, nullptr,
+                nullptr};  ///< the right-hand side, kept only where fields add to it
 };
 
 }  // namespace msfem::massspring::detail

@@ -1,5 +1,5 @@
-// `msfem run` under mpirun: two ranks share the variants and give the one-rank answer, printed once
-// and written once.
+// msfem under mpirun: two ranks share the variants (run) and the loads (calibrate) and give the
+// one-rank answer, printed once and written once.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -147,6 +147,29 @@ TEST(CliMpi, EveryVariantIsTimedOnTwoRanksWithTheOneRankStableStep) {
                 1e-6 * x["stable_dt_s"].get<double>())
         << y["name"];
   }
+}
+
+// msfem calibrate on two ranks: each rank solves its share of the loads at every evaluation, and
+// the fit is the one-rank fit (the FEM references agree to the solver's tolerance, and a handful
+// of evaluations keeps the optimiser on the same path).
+TEST(CliMpi, CalibrateSharesTheLoadsAndFitsAsOneRank) {
+  const std::string mpirun = find_mpirun();
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";
+  TemporaryDirectory one, two;
+  const std::string args = "calibrate " + std::string(MSFEM_TEST_DATA_DIR) +
+                           "/small_calibrate.prm --quiet --no-cache --no-compare "
+                           "--max-evaluations 8 --out ";
+  const auto alone = run_msfem(args + (one / "cal").string());
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const auto shared = run_msfem_on_two_ranks(mpirun, args + (two / "cal").string());
+  ASSERT_EQ(shared.exit_code, 0) << shared.err;
+  const auto a = nlohmann::json::parse(read_text(one / "cal" / "calibration.json"));
+  const auto b = nlohmann::json::parse(read_text(two / "cal" / "calibration.json"));
+  ASSERT_EQ(b["after"]["train"].size(), 2u);
+  ASSERT_EQ(b["after"]["test"].size(), 1u);
+  int compared = 0;
+  expect_same_numbers(a, b, "calibration.json", 1e-5, compared);
+  EXPECT_GT(compared, 30);
 }
 
 TEST(CliMpi, BadInputOnTwoRanksExitsTwoOnceAndWritesNothing) {

@@ -77,6 +77,42 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
 }
 
+// Contact refinement as a sweep dimension: off, and on at two edge lengths, each pass with its own
+// refined surface and FEM; the finer the edge, the more nodes, and each point says its edge.
+TEST(CliSweep, ContactRefinementIsSweptAtEachEdgeLength) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "sweep";
+  const auto r = run_msfem("sweep " + small_case +
+                           " --quiet --resolutions 1 --integrators symplectic_euler "
+                           "--set \"mass spring/variants=single_layer\" --contact-refinement both "
+                           "--contact-edge-lengths 0.006,0.003 --out " +
+                           out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
+  ASSERT_EQ(j["points"].size(), 3u);
+  const auto& points = j["points"];
+  EXPECT_TRUE(points[0]["contact_refinement_edge_m"].is_null());
+  EXPECT_DOUBLE_EQ(points[1]["contact_refinement_edge_m"].get<double>(), 0.006);
+  EXPECT_DOUBLE_EQ(points[2]["contact_refinement_edge_m"].get<double>(), 0.003);
+  EXPECT_LT(points[0]["nodes"].get<int>(), points[1]["nodes"].get<int>());
+  EXPECT_LT(points[1]["nodes"].get<int>(), points[2]["nodes"].get<int>());
+  const std::string report = read_text(out / "report.md");
+  EXPECT_NE(report.find("single_layer+refined@3mm"), std::string::npos) << report;
+  EXPECT_NE(report.find("single_layer+refined@6mm"), std::string::npos) << report;
+
+  for (const std::string bad :
+       {"--contact-refinement maybe", "--contact-refinement off --contact-edge-lengths 0.001",
+        "--contact-edge-lengths -0.001",
+        "--contact-refinement on --set \"loads/tool/enabled=false\" --set "
+        "\"loads/gravity=0,0,-9.81\""}) {
+    const auto refused =
+        run_msfem("sweep " + small_case + " --quiet " + bad + " --out " + (tmp / "bad").string());
+    EXPECT_EQ(refused.exit_code, 2) << bad << ": " << refused.err;
+    EXPECT_NE(refused.err.find("--contact-"), std::string::npos) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+  }
+}
+
 TEST(CliSweep, AMaximumErrorThatIsNotAPositiveNumberIsRefusedBeforeAnySolve) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";

@@ -10,6 +10,7 @@
 #include <nlopt.hpp>
 #include <stdexcept>
 
+#include "calibration/shared_loads.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
@@ -142,8 +143,7 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<Calibratio
                                      const Eigen::VectorXd& stiffness,
                                      const std::vector<ms::MassSpringModel::NamedField>& fields,
                                      double path_step) {
-  std::vector<LoadErrors> errors;
-  for (std::size_t i = 0; i < references.size(); ++i) {
+  return shared_errors(references.size(), [&](std::size_t i) {
     m.variants[i].model->set_stiffness(stiffness);
     for (const auto& field : fields)
       m.variants[i].model->set_field(field.name, field.field);
@@ -153,10 +153,8 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<Calibratio
     const StaticSolution s = equilibrium(m.variants[i], references[i],
                                          m.from_rest ? Eigen::VectorXd() : m.x[i], path_step);
     m.x[i] = s.x;
-    errors.push_back(
-        errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i], s.x));
-  }
-  return errors;
+    return errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i], s.x);
+  });
 }
 
 // The groups to fit (all the variant's when none is named), checked against the variant's own:
@@ -229,9 +227,10 @@ class GroupFit {
       const auto it = std::find(group_id_.begin(), group_id_.end(), network_.spring_group[s]);
       parts[it == group_id_.end() ? 0 : 1 + (it - group_id_.begin())][s] = start_stiffness_[s];
     }
-    for (const auto& v : m.variants)
-      m.linear.push_back(
-          std::make_unique<ms::LinearisedStatics>(*v.model, parts, cholmod_factorization()));
+    for (std::size_t i = 0; i < m.variants.size(); ++i)
+      m.linear.push_back(owns_load(i) ? std::make_unique<ms::LinearisedStatics>(
+                                            *m.variants[i].model, parts, cholmod_factorization())
+                                      : nullptr);
     return m;
   }
 
@@ -247,13 +246,10 @@ class GroupFit {
       weights[g + 1] = std::exp(theta[g]);
     for (const auto& field : base_.model->fields())
       weights.push_back(names_volume_group(*field.field) ? volume_factor_at(theta) : 1.0);
-    std::vector<LoadErrors> errors;
-    for (std::size_t i = 0; i < references.size(); ++i) {
+    return shared_errors(references.size(), [&](std::size_t i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
-      errors.push_back(
-          errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]));
-    }
-    return errors;
+      return errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]);
+    });
   }
 
   /// Each group's start, fitted and case-file values at θ.
@@ -443,7 +439,7 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
   }
   fit.evaluations = static_cast<int>(fit.history.size());
   fit.after.test = fitting.evaluate(test_models, test, best.theta);
-  fit.test_equilibria = test_models.x;
+  fit.test_equilibria = shared_equilibria(test_models.x);
   fit.groups = fitting.fitted_groups(best.theta);
   fit.time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return fit;

@@ -60,7 +60,8 @@ int calibrate_command(const Arguments& args) {
   if (!opt.flag("no-cache")) request.fem_cache_directory = fem_cache_beside(final_dir);
   std::ostringstream printed;
   bool converged = true;
-  // Under mpirun every rank calibrates (the FEM is shared, the fit repeated) and rank 0 writes.
+  // Under mpirun every rank calibrates: the FEM solves on all of them, each evaluation's loads are
+  // shared out (calibration/shared_loads.hpp), and rank 0 writes.
   const bool writes = ranks::is_root();
   ranks::agree([&] {
     if (writes) check_output_folder(final_dir);

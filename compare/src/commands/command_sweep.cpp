@@ -77,16 +77,39 @@ std::vector<bool> volume_settings(const std::string& value) {
   return value == "both" ? std::vector<bool>{false, true} : std::vector<bool>{value == "on"};
 }
 
+// --contact-refinement off|on|both with --contact-edge-lengths E1,E2 (m; each a pass, on implied):
+// none for the off pass, each edge length (0: the case's) for an on pass.
+std::vector<std::optional<double>> refinement_settings(const std::optional<std::string>& mode,
+                                                       const std::optional<std::string>& edges) {
+  if (mode && *mode != "off" && *mode != "on" && *mode != "both")
+    throw cases::InputError("option --contact-refinement: '" + *mode + "' is not off, on or both");
+  if (edges && mode && *mode == "off")
+    throw cases::InputError(
+        "option --contact-edge-lengths: contact refinement is off (--contact-refinement off)");
+  std::vector<std::optional<double>> passes;
+  if (!mode && !edges) return passes;
+  if (mode && *mode != "on") passes.push_back(std::nullopt);
+  if (mode && *mode == "off") return passes;
+  if (!edges) {
+    passes.push_back(0.0);
+    return passes;
+  }
+  for (const auto& edge : split(*edges))
+    passes.push_back(positive_number("contact-edge-lengths", edge));
+  return passes;
+}
+
 }  // namespace
 
 int sweep_command(const Arguments& args) {
-  const Options opt(
-      args, {"quiet", "json"},
-      {"out", "set", "resolutions", "integrators", "max-error", "volume-preservation"});
+  const Options opt(args, {"quiet", "json"},
+                    {"out", "set", "resolutions", "integrators", "max-error", "volume-preservation",
+                     "contact-refinement", "contact-edge-lengths"});
   if (opt.positional().size() != 1)
     throw std::invalid_argument(
         "usage: msfem sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--max-error E] "
-        "[--volume-preservation off|on|both] [--out DIR]");
+        "[--volume-preservation off|on|both] [--contact-refinement off|on|both] "
+        "[--contact-edge-lengths E1,E2] [--out DIR]");
   std::optional<double> max_error;
   if (const auto e = opt.value("max-error")) max_error = positive_number("max-error", *e);
   const cases::CaseParameters parameters = cases::read_case(opt.positional()[0], opt.values("set"));
@@ -95,6 +118,12 @@ int sweep_command(const Arguments& args) {
   if (const auto r = opt.value("resolutions")) settings.resolutions = integers("resolutions", *r);
   if (const auto v = opt.value("volume-preservation"))
     settings.volume_preservation = volume_settings(*v);
+  settings.contact_refinement =
+      refinement_settings(opt.value("contact-refinement"), opt.value("contact-edge-lengths"));
+  if (!settings.contact_refinement.empty() && !parameters.loads.tool.enabled)
+    throw cases::InputError(
+        parameters.file.string() +
+        ": --contact-refinement refines around the tool, but loads/tool is off");
   if (const auto i = opt.value("integrators")) {
     settings.integrators.clear();
     for (const auto& name : split(*i))

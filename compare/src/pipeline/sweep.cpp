@@ -17,6 +17,17 @@
 #include "msfem/compare/writers/run_summary.hpp"
 
 namespace msfem::compare {
+
+std::string SweepPoint::model() const {
+  std::string name = volume_preservation ? variant + "+volume" : variant;
+  if (contact_edge_m) {
+    char edge[48];
+    std::snprintf(edge, sizeof edge, "+refined@%.3gmm", *contact_edge_m * 1e3);
+    name += edge;
+  }
+  return name;
+}
+
 namespace {
 
 std::vector<int> default_resolutions(const cases::CaseParameters& p) {
@@ -58,6 +69,7 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   pt.integrator = massspring::to_string(integrator);
   pt.stepper = t.stepper;
   pt.volume_preservation = v.parameters.contains("volume_preservation");
+  if (run.problem.local_refinement) pt.contact_edge_m = run.problem.local_refinement->edge_m;
   pt.resolution = resolution;
   pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
   pt.nodes = v.nodes;
@@ -78,6 +90,7 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
 nlohmann::json point_json(const SweepPoint& p) {
   return {{"variant", p.variant},
           {"volume_preservation", p.volume_preservation},
+          {"contact_refinement_edge_m", json_or_null(p.contact_edge_m)},
           {"integrator", p.integrator},
           {"stepper", p.stepper},
           {"resolution", p.resolution},
@@ -104,6 +117,7 @@ SweepPoint point_from_json(const nlohmann::json& j) {
   SweepPoint p;
   j.at("variant").get_to(p.variant);
   j.at("volume_preservation").get_to(p.volume_preservation);
+  p.contact_edge_m = optional_number(j.at("contact_refinement_edge_m"));
   j.at("integrator").get_to(p.integrator);
   j.at("stepper").get_to(p.stepper);
   for (auto [key, to] : {std::pair{"resolution", &p.resolution},
@@ -166,16 +180,28 @@ std::vector<int> owners(
   return owner;
 }
 
+// One pass's settings beside the resolution: volume preservation and contact refinement.
+struct SweepPass {
+  bool volume = false;
+  std::optional<double> contact_edge_m;  ///< none: refinement off; 0: the case's edge length
+};
+
 // One resolution's points with volume preservation as `volume`: every variant that has the
 // setting's model with every integrator (a variant without volume elements is left out of the
 // volume-preserving pass: it would repeat the other's points). The FEM comes from the cache after
 // the first pass. Under mpirun the (variant, integrator) items are dealt out (owners) and timed at
 // the same time, one per rank: each timing is single-threaded on its rank's own core.
 std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
-                                         const SweepSettings& settings, bool volume,
+                                         const SweepSettings& settings, const SweepPass& pass,
                                          const std::filesystem::path& fem_cache_directory) {
   cases::CaseParameters p = at_resolution(parameters, resolution);
+  const bool volume = pass.volume;
   p.mass_spring.volume_preservation = volume;
+  if (!settings.contact_refinement.empty()) {
+    p.mass_spring.contact_refinement.enabled = pass.contact_edge_m.has_value();
+    if (pass.contact_edge_m && *pass.contact_edge_m > 0)
+      p.mass_spring.contact_refinement.edge_m = *pass.contact_edge_m;
+  }
   RunSettings run_settings;
   run_settings.quiet = true;
   run_settings.force_depth_curve = false;
@@ -218,6 +244,13 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
       settings.volume_preservation.empty()
           ? std::vector<bool>{parameters.mass_spring.volume_preservation}
           : settings.volume_preservation;
+  const std::vector<std::optional<double>> refinement_settings =
+      settings.contact_refinement.empty() ? std::vector<std::optional<double>>{std::nullopt}
+                                          : settings.contact_refinement;
+  std::vector<SweepPass> passes;
+  for (const bool volume : volume_settings)
+    for (const auto& edge : refinement_settings)
+      passes.push_back({volume, edge});
   const Progress progress(settings.quiet);
   const auto start = std::chrono::steady_clock::now();
   SweepResult result;
@@ -227,10 +260,10 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
     try {
       // All of a resolution's points or none of them.
       std::vector<SweepPoint> more;
-      for (const bool volume : volume_settings) {
-        const std::vector<SweepPoint> pass =
-            sweep_resolution(parameters, resolutions[r], settings, volume, fem_cache_directory);
-        more.insert(more.end(), pass.begin(), pass.end());
+      for (const SweepPass& pass : passes) {
+        const std::vector<SweepPoint> swept =
+            sweep_resolution(parameters, resolutions[r], settings, pass, fem_cache_directory);
+        more.insert(more.end(), swept.begin(), swept.end());
       }
       points.insert(points.end(), more.begin(), more.end());
     } catch (const std::exception& e) {

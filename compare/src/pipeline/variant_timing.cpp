@@ -22,8 +22,8 @@ namespace ms = msfem::massspring;
 // symplectic Euler with velocities read at half steps is the leapfrog form of central difference:
 // one force evaluation per step, the same stable step) and, with `symplectic` off, explicit Euler,
 // with the model's force fields (the tool's contact, volume preservation); FastImplicitStepper for
-// implicit Euler (with the haptic CG settings msfem bench times) on a model without fields; the
-// generic Integrator for RK4 and implicit Euler with a field, which the fast kernels do not have.
+// implicit Euler (with the haptic CG settings msfem bench times), fields included; the generic
+// Integrator for RK4, which the fast kernels do not have.
 class TimedStepper {
  public:
   TimedStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, const ms::State& start)
@@ -35,7 +35,7 @@ class TimedStepper {
       options.symplectic = kind != ms::IntegratorKind::explicit_euler;
       explicit_ = std::make_unique<ms::FastExplicitStepper>(model, options);
       explicit_->set_state(start);
-    } else if (kind == ms::IntegratorKind::implicit_euler && model.fields().empty()) {
+    } else if (kind == ms::IntegratorKind::implicit_euler) {
       implicit_ = std::make_unique<ms::FastImplicitStepper>(model);
       implicit_->set_state(start);
     }

@@ -22,7 +22,8 @@ struct FastImplicitOptions {
   /// With threads > 1: step on the calling thread alone while that is faster (when other programs
   /// hold the cores, every one of a step's ~15 barriers waits for a pre-empted thread). Measured
   /// per step, re-checked by 4 steps on the other count after every 32 to 256 steps. Results do not
-  /// depend on it: sums are taken per block of nodes in a fixed order, for any number of threads.
+  /// depend on it: sums are taken per block of nodes in a fixed order, for any number of threads
+  /// (a force field's parts are summed per thread, so with one only to rounding).
   bool adaptive_threads = true;
 };
 
@@ -33,8 +34,12 @@ struct FastImplicitOptions {
 /// by the 3x3 diagonal blocks solves (M - h D - h² K) Δv = h (f + h K v) matrix-free, in the
 /// Chronopoulos-Gear form (one pass over the nodes and one reduction per product; the same
 /// iterates as plain CG in exact arithmetic). Each product is one gather over the springs (per
-/// spring and end y += α q + (e·q) e, α = h² k τ, e = √(h c + h² k (1 - τ)) n). Tool contact is not
-/// applied. The model must outlive the stepper.
+/// spring and end y += α q + (e·q) e, α = h² k τ, e = √(h c + h² k (1 - τ)) n). The model's force
+/// fields (the tool's contact, volume preservation) enter the same system through their
+/// ForceField calls at their nodes: force and definite ∂f/∂x, ∂f/∂v products, and their diagonal
+/// blocks in the preconditioner (one more barrier per product), and a field on every node
+/// (volume preservation) shares its elements among the threads. The model must outlive the
+/// stepper.
 class FastImplicitStepper {
  public:
   explicit FastImplicitStepper(const MassSpringModel& model,

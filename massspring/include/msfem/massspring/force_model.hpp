@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <memory>
 #include <string>
@@ -65,9 +66,9 @@ class ForceModel {
 /// (copies of the model share them); a changed field is a new one put in its place.
 class ForceField : public ForceModel {
  public:
-  /// The nodes whose forces this field sets, and the only ones whose x and v add_force reads (the
-  /// static solver's node relaxation leaves them to Newton, unless it knows the field; the fast
-  /// explicit stepper gathers x and v at these nodes only).
+  /// The nodes whose forces this field sets, and the only ones whose x, v (and, in the products,
+  /// dx) the field reads (the static solver's node relaxation leaves them to Newton, unless it
+  /// knows the field; the fast steppers gather x, v and dx at these nodes only).
   virtual const std::vector<int>& nodes() const = 0;
   /// Names of the coefficient groups a fit may scale, each one factor on a set of stiffnesses
   /// (volume preservation: "volume"); none by default.
@@ -83,6 +84,20 @@ class ForceField : public ForceModel {
     (void)parts;
     if (part == 0) add_force(x, v, f);
   }
+  /// Part `part` of `parts` of add_dfdx_product, shared among threads as add_force_part is (the
+  /// fast implicit stepper's CG products). By default part 0 is the whole product.
+  virtual void add_dfdx_product_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                     const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                                     Linearisation mode, int part, int parts) const {
+    (void)parts;
+    if (part == 0) add_dfdx_product(x, v, dx, df, mode);
+  }
+  /// blocks[i] += cx (∂f/∂x)_ii + cv (∂f/∂v)_ii, the 3x3 diagonal blocks at the field's nodes i
+  /// (`blocks` has one per model node): what a block-Jacobi preconditioner of M - h D - h² K
+  /// needs. By default taken from the triplets, which suits a field on a few nodes.
+  virtual void add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd& v, double cx,
+                                   double cv, std::vector<Eigen::Matrix3d>& blocks,
+                                   Linearisation mode) const;
 };
 
 }  // namespace msfem::massspring

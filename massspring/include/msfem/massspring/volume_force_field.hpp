@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "msfem/massspring/force_model.hpp"
@@ -47,6 +48,12 @@ class VolumeForceField : public ForceField {
   void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                         const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                         Linearisation mode = Linearisation::exact) const override;
+  /// Elements [E·part/parts, E·(part+1)/parts) only.
+  void add_dfdx_product_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                             const Eigen::VectorXd& dx, Eigen::VectorXd& df, Linearisation mode,
+                             int part, int parts) const override;
+  void add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd& v, double cx, double cv,
+                           std::vector<Eigen::Matrix3d>& blocks, Linearisation mode) const override;
   void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd&,
                         Eigen::VectorXd&) const override {}
   void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
@@ -68,6 +75,11 @@ class VolumeForceField : public ForceField {
  private:
   static constexpr int kMaxElementNodes = 16;
   void index_element_nodes();
+  /// Element e's volume at x, with g = −6 ∂V/∂x per distinct node of the element.
+  double element_gradient(int e, const double* x, Eigen::Vector3d (&g)[kMaxElementNodes]) const;
+  std::pair<int, int> element_range(int part, int parts) const;
+  void add_exact_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                         int first, int last) const;
 
   int num_nodes_;
   VolumeElements elements_;

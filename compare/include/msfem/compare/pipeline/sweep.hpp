@@ -21,6 +21,9 @@ struct SweepSettings {
   /// Volume preservation off and/or on for the variants that have it (three_tier, tet_edges);
   /// empty: as the case sets it.
   std::vector<bool> volume_preservation;
+  /// Contact refinement (a local point distribution at the tool) per pass: none for off, else on
+  /// with that edge length (m; 0: the case's). Empty: as the case sets it.
+  std::vector<std::optional<double>> contact_refinement;
   bool quiet = false;
 };
 
@@ -28,8 +31,11 @@ struct SweepPoint {
   std::string variant, integrator;
   std::string stepper;               ///< the code timed (Timing::stepper)
   bool volume_preservation = false;  ///< the variant's volume elements on
-  /// The variant as the report names it: with volume preservation, "variant+volume".
-  std::string model() const { return volume_preservation ? variant + "+volume" : variant; }
+  /// With contact refinement on: the longest surface edge (m) within its radius of the tool.
+  std::optional<double> contact_edge_m;
+  /// The variant as the report names it: "variant", then "+volume" with volume preservation and
+  /// "+refined@E mm" with contact refinement.
+  std::string model() const;
   int resolution = 0;  ///< level or vertex target, as given
   int surface_vertices = 0;
   int nodes = 0, springs = 0;

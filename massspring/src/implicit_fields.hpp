@@ -1,0 +1,212 @@
+// The model's force fields (tool contact, volume preservation) in the fast implicit stepper's
+// backward-Euler system (fast_implicit_stepper.hpp). The spring kernels assemble
+//   A_s = M - h D_s - h² K_s,   b_s = h (f_s + h K_s v)
+// per lane; a field F adds A_F = -h D_F - h² K_F (definite K_F) and b_F = h (f_F + h K_F v) at its
+// nodes, through its ForceField calls on full-size vectors gathered at those nodes only. So that
+// no member writes a lane another member reads before a barrier, each member handles the field
+// nodes whose lanes lie in its own blocks (member 0 also the constrained ones, which have no lane).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Dense>
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+#include "msfem/massspring/mass_spring_model.hpp"
+#include "node_gather_layout.hpp"
+
+namespace msfem::massspring::detail {
+
+template <class Real, int W>
+class ImplicitFields {
+ public:
+  ImplicitFields(const SoaLayout<Real>& soa, const NodeGatherLayout<Real, W>& gather, int team)
+      : soa_(&soa), gather_(&gather), team_(team) {}
+
+  bool empty() const { return fields_.empty(); }
+
+  // The model's fields and, per field node, its new id, lane and block (-1 when constrained).
+  void take(const MassSpringModel& model) {
+    fields_.clear();
+    std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
+    for (const auto& field : model.fields()) {
+      fields_.push_back(field.field);
+      for (int node : field.field->nodes())
+        used[static_cast<std::size_t>(node)] = 1;
+    }
+    std::vector<int> lane_of(static_cast<std::size_t>(soa_->num_nodes), -1);
+    for (std::size_t lane = 0; lane < gather_->lane_node.size(); ++lane)
+      if (gather_->lane_node[lane] != gather_->idle_record)
+        lane_of[static_cast<std::size_t>(gather_->lane_node[lane])] = static_cast<int>(lane);
+    nodes_.clear();
+    for (int node = 0; node < soa_->num_nodes; ++node) {
+      if (!used[static_cast<std::size_t>(node)]) continue;
+      const int id = soa_->new_id[static_cast<std::size_t>(node)];
+      const int lane = lane_of[static_cast<std::size_t>(id)];
+      int block = -1;
+      if (lane >= 0) {
+        const auto& begin = gather_->block_begin;
+        block = static_cast<int>(std::upper_bound(begin.begin(), begin.end(), lane / W) -
+                                 begin.begin()) -
+                1;
+      }
+      nodes_.push_back({node, id, lane, block});
+    }
+    const Eigen::Index dofs = 3 * static_cast<Eigen::Index>(soa_->num_nodes);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(fields_.empty() ? 0 : dofs);
+    for (auto* v : {&x_, &v_, &hv_, &dv_, &hdv_, &hu_, &u_})
+      *v = zero;
+    for (auto* per_member : {&b_part_, &a_part_, &product_part_})
+      per_member->assign(static_cast<std::size_t>(team_), zero);
+    blocks_.assign(fields_.empty() ? 0 : static_cast<std::size_t>(soa_->num_nodes),
+                   Eigen::Matrix3d::Zero());
+    member_dots_.assign(static_cast<std::size_t>(team_), 0.0);
+  }
+
+  // Before the linearising pass: x, v and the warm start Δv at this member's field nodes.
+  void gather_state(int b0, int b1, const Real* records, const Real* dv_records, double h) {
+    for (const Node& n : nodes_) {
+      if (!owns(n, b0, b1)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const Eigen::Index k = 3 * n.node + c;
+        x_[k] = records[kRecord * n.id + c];
+        v_[k] = records[kRecord * n.id + 3 + c];
+        dv_[k] = dv_records[kDirection * n.id + c];
+        hv_[k] = h * v_[k];
+        hdv_[k] = h * dv_[k];
+      }
+    }
+  }
+
+  // After the pass's barrier, this member's part of the fields' right-hand side, b_F / h =
+  // f_F + K_F (h v), and of -A_F Δv / h = K_F (h Δv) + D_F Δv; member 0 also the diagonal blocks
+  // of -A_F = h D_F + h² K_F.
+  void start_part(int member, int members, double h) {
+    Eigen::VectorXd& b = b_part_[static_cast<std::size_t>(member)];
+    Eigen::VectorXd& a = a_part_[static_cast<std::size_t>(member)];
+    zero_at_nodes(b);
+    zero_at_nodes(a);
+    for (const auto& field : fields_) {
+      field->add_force_part(x_, v_, b, member, members);
+      field->add_dfdx_product_part(x_, v_, hv_, b, Linearisation::definite, member, members);
+      field->add_dfdx_product_part(x_, v_, hdv_, a, Linearisation::definite, member, members);
+      if (member == 0) field->add_dfdv_product(x_, dv_, a);
+    }
+    if (member != 0) return;
+    for (const Node& n : nodes_)
+      blocks_[static_cast<std::size_t>(n.node)].setZero();
+    for (const auto& field : fields_)
+      field->add_diagonal_blocks(x_, v_, h * h, h, blocks_, Linearisation::definite);
+  }
+
+  // After the next barrier, at this member's field lanes: b += b_F, r += b_F - A_F Δv, the
+  // preconditioner's block B += A_F (re-inverted), u = B⁻¹ r into cg.p and `u_records`.
+  void start_apply(int b0, int b1, int members, const CgVectors<Real>& cg, Real* u_records,
+                   double h) {
+    for (const Node& n : nodes_) {
+      if (n.lane < 0 || !owns(n, b0, b1)) continue;
+      Eigen::Vector3d b_field = Eigen::Vector3d::Zero(), a_field = Eigen::Vector3d::Zero();
+      for (int m = 0; m < members; ++m) {
+        b_field += b_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
+        a_field += a_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
+      }
+      Eigen::Vector3d r;
+      for (int c = 0; c < 3; ++c) {
+        cg.b[c][n.lane] += static_cast<Real>(h * b_field[c]);
+        cg.r[c][n.lane] += static_cast<Real>(h * (b_field[c] + a_field[c]));
+        r[c] = cg.r[c][n.lane];
+      }
+      const Eigen::Matrix3d block =
+          read_block(cg, n.lane).inverse() - blocks_[static_cast<std::size_t>(n.node)];
+      const Eigen::Matrix3d inverse = block.inverse();
+      write_block(cg, n.lane, inverse);
+      const Eigen::Vector3d u = inverse * r;
+      for (int c = 0; c < 3; ++c) {
+        cg.p[c][n.lane] = static_cast<Real>(u[c]);
+        u_records[kDirection * n.id + c] = static_cast<Real>(u[c]);
+      }
+    }
+  }
+
+  // Before a product: h u at this member's field nodes (u of every node is complete in
+  // `u_records` since the last reduction).
+  void gather_direction(int b0, int b1, const Real* u_records, double h) {
+    for (const Node& n : nodes_) {
+      if (!owns(n, b0, b1)) continue;
+      for (int c = 0; c < 3; ++c) {
+        u_[3 * n.node + c] = u_records[kDirection * n.id + c];
+        hu_[3 * n.node + c] = h * u_[3 * n.node + c];
+      }
+    }
+  }
+
+  // After the product's barrier: this member's part of -A_F u / h = K_F (h u) + D_F u, and its
+  // part of u·(-A_F u)/h.
+  void product_part(int member, int members) {
+    Eigen::VectorXd& y = product_part_[static_cast<std::size_t>(member)];
+    zero_at_nodes(y);
+    for (const auto& field : fields_) {
+      field->add_dfdx_product_part(x_, v_, hu_, y, Linearisation::definite, member, members);
+      if (member == 0) field->add_dfdv_product(x_, u_, y);
+    }
+    double dot = 0.0;
+    for (const Node& n : nodes_)
+      dot += u_.template segment<3>(3 * n.node).dot(y.template segment<3>(3 * n.node));
+    member_dots_[static_cast<std::size_t>(member)] = dot;
+  }
+
+  // After the next barrier: w += A_F u at this member's field lanes; returns u·A_F u (every
+  // member the same sum).
+  double product_apply(int b0, int b1, int members, const CgVectors<Real>& cg, double h) const {
+    for (const Node& n : nodes_) {
+      if (n.lane < 0 || !owns(n, b0, b1)) continue;
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        for (int m = 0; m < members; ++m)
+          sum += product_part_[static_cast<std::size_t>(m)][3 * n.node + c];
+        cg.y[c][n.lane] -= static_cast<Real>(h * sum);
+      }
+    }
+    double dot = 0.0;
+    for (int m = 0; m < members; ++m)
+      dot += member_dots_[static_cast<std::size_t>(m)];
+    return -h * dot;
+  }
+
+ private:
+  struct Node {
+    int node, id, lane, block;  // original id, layout id, lane (-1: constrained), block
+  };
+
+  static bool owns(const Node& n, int b0, int b1) {
+    return n.block < 0 ? b0 == 0 : n.block >= b0 && n.block < b1;
+  }
+  void zero_at_nodes(Eigen::VectorXd& vector) const {
+    for (const Node& n : nodes_)
+      vector.template segment<3>(3 * n.node).setZero();
+  }
+  static Eigen::Matrix3d read_block(const CgVectors<Real>& cg, int lane) {
+    const auto q = [&](int e) { return static_cast<double>(cg.inverse_block[e][lane]); };
+    Eigen::Matrix3d m;
+    m << q(0), q(3), q(4), q(3), q(1), q(5), q(4), q(5), q(2);
+    return m;
+  }
+  static void write_block(const CgVectors<Real>& cg, int lane, const Eigen::Matrix3d& m) {
+    const double entries[6] = {m(0, 0), m(1, 1), m(2, 2), m(0, 1), m(0, 2), m(1, 2)};
+    for (int e = 0; e < 6; ++e)
+      cg.inverse_block[e][lane] = static_cast<Real>(entries[e]);
+  }
+
+  const SoaLayout<Real>* soa_;
+  const NodeGatherLayout<Real, W>* gather_;
+  int team_;
+  std::vector<std::shared_ptr<const ForceField>> fields_;
+  std::vector<Node> nodes_;
+  Eigen::VectorXd x_, v_, hv_, dv_, hdv_, hu_, u_;  // shared, written at field nodes by owners
+  std::vector<Eigen::VectorXd> b_part_, a_part_, product_part_;  // per member
+  std::vector<Eigen::Matrix3d> blocks_;                          // per node: h D_F + h² K_F
+  std::vector<double> member_dots_;
+};
+
+}  // namespace msfem::massspring::detail
