@@ -211,8 +211,8 @@ TEST(CaseSettings, EveryIntegratorIsTheOneTimed) {
     }
     // On the code a simulator runs: the fast kernels for the schemes they have.
     using K = massspring::IntegratorKind;
-    const bool fast_explicit =
-        kind == K::symplectic_euler || kind == K::central_difference || kind == K::explicit_euler;
+    const bool fast_explicit = kind == K::symplectic_euler || kind == K::central_difference ||
+                               kind == K::explicit_euler || kind == K::rk4;
     EXPECT_EQ(t.stepper, fast_explicit               ? "fast_explicit"
                          : kind == K::implicit_euler ? "fast_implicit"
                                                      : "generic")
@@ -225,8 +225,9 @@ TEST(CaseSettings, EveryIntegratorIsTheOneTimed) {
   const BuiltVariant contact =
       build_variant(cases::Variant::single_layer, pressed, mesh, pressed.tools.front());
   ASSERT_FALSE(contact.model->fields().empty());
-  for (const auto kind : {massspring::IntegratorKind::central_difference,
-                          massspring::IntegratorKind::implicit_euler}) {
+  for (const auto kind :
+       {massspring::IntegratorKind::central_difference, massspring::IntegratorKind::rk4,
+        massspring::IntegratorKind::implicit_euler}) {
     cases::TimingParameters timing = with({"timing/integrator=" + name_of(kind)}).timing;
     timing.steps = 50;
     const Timing t = time_variant(contact, timing, contact.model->initial_state(), false);

@@ -20,19 +20,21 @@ namespace ms = msfem::massspring;
 
 // The stepper timed: FastExplicitStepper for symplectic Euler and central difference (its
 // symplectic Euler with velocities read at half steps is the leapfrog form of central difference:
-// one force evaluation per step, the same stable step) and, with `symplectic` off, explicit Euler,
-// with the model's force fields (the tool's contact, volume preservation); FastImplicitStepper for
-// implicit Euler (with the haptic CG settings msfem bench times) on a model without fields; the
-// generic Integrator for RK4 and implicit Euler with a field, which the fast kernels do not have.
+// one force evaluation per step, the same stable step), explicit Euler and RK4, with the model's
+// force fields (the tool's contact, volume preservation); FastImplicitStepper for implicit Euler
+// (with the haptic CG settings msfem bench times) on a model without fields; the generic
+// Integrator for implicit Euler with a field, which the fast implicit kernels do not have.
 class TimedStepper {
  public:
   TimedStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, const ms::State& start)
       : model_(model), integrator_(kind), state_(start) {
     if (kind == ms::IntegratorKind::symplectic_euler ||
         kind == ms::IntegratorKind::central_difference ||
-        kind == ms::IntegratorKind::explicit_euler) {
+        kind == ms::IntegratorKind::explicit_euler || kind == ms::IntegratorKind::rk4) {
       ms::FastStepperOptions options;
-      options.symplectic = kind != ms::IntegratorKind::explicit_euler;
+      options.integrator = kind == ms::IntegratorKind::central_difference
+                               ? ms::IntegratorKind::symplectic_euler
+                               : kind;
       explicit_ = std::make_unique<ms::FastExplicitStepper>(model, options);
       explicit_->set_state(start);
     } else if (kind == ms::IntegratorKind::implicit_euler && model.fields().empty()) {
