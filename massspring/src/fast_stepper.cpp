@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <sstream>
 
 #include "adaptive_threads.hpp"
@@ -46,7 +47,10 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))},
-        symplectic_(options.symplectic) {
+        integrator_(options.integrator) {
+    if (integrator_ == IntegratorKind::rk4)
+      for (auto& stage : stages_)
+        stage.resize(records_[0].size());
     take_fields(model);
     pack();
   }
@@ -86,31 +90,43 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
  private:
   void step_springs(double dt, int count, int members) {
-    const Real h = static_cast<Real>(dt);
     std::vector<double> check(team_.size(), 0.0);
-    // Blocks are taken from one ticket counter. In each step every member draws tickets until it
-    // gets one past the step's blocks, so a step uses exactly blocks + members tickets and the
-    // next step's tickets start at a known number without resetting the counter.
+    // Blocks are taken from one ticket counter. In each pass over the chunks every member draws
+    // tickets until it gets one past the pass's blocks, so a pass uses exactly blocks + members
+    // tickets and the next pass's tickets start at a known number without resetting the counter.
     const long blocks = static_cast<long>(gather_.block_begin.size()) - 1;
-    const long per_step = blocks + members;
+    const long per_pass = blocks + members;
     field_diverged_.store(false, std::memory_order_relaxed);
     ticket_.store(0, std::memory_order_relaxed);
     const std::function<void(int)> job = [&](int member) {
+      long pass = 0;
+      // This member's share of one pass: kernel(begin, end) on the blocks it draws.
+      const auto share = [&](const auto& kernel) {
+        double sum = 0.0;
+        for (long block = ticket_.fetch_add(1, std::memory_order_relaxed) - pass * per_pass;
+             block < blocks;
+             block = ticket_.fetch_add(1, std::memory_order_relaxed) - pass * per_pass)
+          sum += kernel(gather_.block_begin[block], gather_.block_begin[block + 1]);
+        ++pass;
+        return sum;
+      };
       int from = current_;
       double sum = 0.0;
       for (int n = 0; n < count; ++n) {
         const Real* cur = records_[from].data();
         Real* next = records_[1 - from].data();
-        sum = 0.0;
-        for (long block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step;
-             block < blocks;
-             block = ticket_.fetch_add(1, std::memory_order_relaxed) - n * per_step) {
-          const int begin = gather_.block_begin[block], end = gather_.block_begin[block + 1];
-          sum += kernels_.explicit_step(gather_, cur, next, begin, end, h, symplectic_);
+        if (integrator_ == IntegratorKind::rk4) {
+          sum = rk4_step(member, members, dt, cur, next, share);
+        } else {
+          const Real h = static_cast<Real>(dt);
+          const bool symplectic = integrator_ == IntegratorKind::symplectic_euler;
+          sum = share([&](int begin, int end) {
+            return kernels_.explicit_step(gather_, cur, next, begin, end, h, symplectic);
+          });
+          if (!fields_.empty())  // symplectic: x' = x + h v' takes the impulse too
+            add_field_impulses(member, members, cur, {{next, dt, symplectic ? dt : 0.0}});
         }
         from = 1 - from;
-        if (!fields_.empty())
-          add_field_impulses(member, members, dt, records_[1 - from].data(), records_[from].data());
         // run() itself waits for the last step
         if (n + 1 < count && members > 1) team_.barrier();
       }
@@ -128,6 +144,36 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     if (!std::isfinite(total) || field_diverged_.load()) report_divergence(dt);
   }
 
+  // Classical RK4 as Integrator::step has it, one kernel pass per stage: stage s reads the state
+  // the last stage wrote (`cur` for the first) and every neighbour's part of it, hence a barrier
+  // between stages; stage states alternate between stages_[0] and [1], and `next` holds the
+  // running combination until it is the result. A field's force at the stage state is an extra
+  // acceleration: it moves the next stage's v by c and the combination's v by w times it.
+  template <class Share>
+  double rk4_step(int member, int members, double dt, const Real* cur, Real* next,
+                  const Share& share) {
+    static constexpr double kToNext[3] = {0.5, 0.5, 1.0};
+    static constexpr double kWeight[4] = {1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0};
+    const Real* in = cur;
+    double sum = 0.0;
+    for (int s = 0; s < 4; ++s) {
+      const detail::RkStage stage = s == 0   ? detail::RkStage::first
+                                    : s == 3 ? detail::RkStage::last
+                                             : detail::RkStage::middle;
+      Real* out = s < 3 ? stages_[s % 2].data() : nullptr;
+      const double c = s < 3 ? kToNext[s] * dt : 0.0, w = kWeight[s] * dt;
+      sum = share([&](int begin, int end) {
+        return kernels_.rk4_stage(gather_, stage, in, cur, out, next, begin, end,
+                                  static_cast<Real>(c), static_cast<Real>(w));
+      });
+      if (!fields_.empty())
+        add_field_impulses(member, members, in, {{out, c, 0.0}, {next, w, 0.0}});
+      if (s < 3 && members > 1) team_.barrier();
+      in = out;
+    }
+    return sum;
+  }
+
  public:
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
@@ -138,8 +184,14 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     const std::size_t per_slot =
         sizeof(int) +
         (gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) * sizeof(Real);
-    return lanes * (sizeof(int) + 6 * sizeof(Real)) + slots * per_slot +
-           gather_.chunk_slot.size() * sizeof(int) + 2 * records_[0].size() * sizeof(Real);
+    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real)) + slots * per_slot +
+                             gather_.chunk_slot.size() * sizeof(int);
+    const std::size_t buffer = records_[0].size() * sizeof(Real);
+    // RK4's record buffers: the first stage reads `in` and writes out and acc (3), the middle two
+    // read in, base and acc and write out and acc (5 each), the last reads in and acc and writes
+    // acc (3).
+    if (integrator_ == IntegratorKind::rk4) return 4 * pass + (3 + 5 + 5 + 3) * buffer;
+    return pass + 2 * buffer;
   }
 
  private:
@@ -168,13 +220,22 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     return {n * member / members, n * (member + 1) / members};
   }
 
-  // Symplectic Euler with the fields' force f_F(x, v) of the step's start: v' = v'_springs +
-  // h M⁻¹ f_F and x' = x + h v' = x'_springs + h² M⁻¹ f_F, on the free nodes (explicit Euler: x'
-  // advances with the starting v, so only v' takes the field's impulse). The members share
-  // the work: each gathers its share of the field nodes' x and v, adds its part of every field
-  // (ForceField::add_force_part) into its own force vector, and once all have, sums the members'
-  // forces at its share of the nodes and applies them. Two barriers; none when alone.
-  void add_field_impulses(int member, int members, double dt, const Real* before, Real* after) {
+  // A buffer a pass wrote whose free nodes take the fields' force: Δv = v_scale M⁻¹ f_F into v and
+  // x_scale Δv into x. No records: nothing to take it.
+  struct FieldTarget {
+    Real* records;
+    double v_scale, x_scale;
+  };
+
+  // The fields' force f_F(x, v) at the state `before` the pass read, added to the targets the pass
+  // wrote: symplectic Euler v' = v'_springs + h M⁻¹ f_F and x' = x + h v' = x'_springs +
+  // h² M⁻¹ f_F (explicit Euler: x' advances with the starting v, so only v' takes the impulse;
+  // RK4: see rk4_step). The members share the work: each gathers its share of the field nodes' x
+  // and v, adds its part of every field (ForceField::add_force_part) into its own force vector,
+  // and once all have, sums the members' forces at its share of the nodes and applies them. Two
+  // barriers; none when alone.
+  void add_field_impulses(int member, int members, const Real* before,
+                          std::initializer_list<FieldTarget> targets) {
     Eigen::VectorXd& f = field_f_[static_cast<std::size_t>(member)];
     for (int node : field_nodes_)
       f.segment<3>(3 * node).setZero();
@@ -201,9 +262,13 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         for (int m = 0; m < members; ++m)
           force += field_f_[static_cast<std::size_t>(m)][3 * node + c];
         if (!std::isfinite(force)) diverged = true;
-        const Real dv = static_cast<Real>(dt * soa_.inverse_mass[i] * force);
-        after[kRecord * i + 3 + c] += dv;
-        if (symplectic_) after[kRecord * i + c] += static_cast<Real>(dt) * dv;
+        for (const FieldTarget& target : targets) {
+          if (!target.records) continue;
+          const Real dv = static_cast<Real>(target.v_scale * soa_.inverse_mass[i] * force);
+          target.records[kRecord * i + 3 + c] += dv;
+          if (target.x_scale != 0.0)
+            target.records[kRecord * i + c] += static_cast<Real>(target.x_scale) * dv;
+        }
       }
     }
     if (diverged) field_diverged_.store(true, std::memory_order_relaxed);
@@ -212,9 +277,10 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   // Both record buffers from the layout's per-component arrays: the constrained nodes are read
   // from either, and the idle and far records never change.
   void pack() {
-    for (auto& records : records_) {
-      Real* r = records.data();
-      std::fill(r, r + records.size(), Real(0));
+    for (auto* records : {&records_[0], &records_[1], &stages_[0], &stages_[1]}) {
+      if (records->empty()) continue;
+      Real* r = records->data();
+      std::fill(r, r + records->size(), Real(0));
       for (int i = 0; i < soa_.num_nodes; ++i)
         for (int c = 0; c < 3; ++c) {
           r[kRecord * i + c] = soa_.x[c][i];
@@ -234,8 +300,9 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   }
 
   [[noreturn]] void report_divergence(double dt) {
-    const double stable =
-        predicted_stable_dt(*model_, IntegratorKind::central_difference, model_->initial_state());
+    const IntegratorKind kind =
+        integrator_ == IntegratorKind::rk4 ? integrator_ : IntegratorKind::central_difference;
+    const double stable = predicted_stable_dt(*model_, kind, model_->initial_state());
     std::ostringstream out;
     out << "fast stepper diverged by t = " << time_ << " s with dt = " << dt
         << " s: non-finite state; predicted stable dt = " << stable
@@ -249,6 +316,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   detail::SoaLayout<Real> soa_;
   NodeGatherLayout<Real, W> gather_;
   detail::AlignedVector<Real> records_[2];  // x, v per node (kRecord), previous and next step
+  detail::AlignedVector<Real> stages_[2];   // RK4's stage states (empty for the Euler schemes)
   std::vector<std::shared_ptr<const ForceField>> fields_;
   std::vector<int> field_nodes_;  ///< original node ids
   Eigen::VectorXd field_x_, field_v_;
@@ -257,7 +325,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   std::atomic<long> ticket_{0};
   int current_ = 0;
   double time_ = 0.0;
-  bool symplectic_ = true;
+  IntegratorKind integrator_;
   detail::Kernels<Real, W> kernels_;
 };
 
@@ -265,6 +333,11 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
 FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
                                          const FastStepperOptions& options) {
+  if (options.integrator != IntegratorKind::symplectic_euler &&
+      options.integrator != IntegratorKind::explicit_euler &&
+      options.integrator != IntegratorKind::rk4)
+    throw ModelError("fast explicit stepper: integrator '" + to_string(options.integrator) +
+                     "' not supported (symplectic_euler, explicit_euler, rk4)");
   if (options.single_precision &&
       detail::preferred_lanes<float>(options.allow_avx512, model.network().num_springs(),
                                      model.num_nodes()) == 16)

@@ -1,9 +1,10 @@
 #pragma once
 
-// The node-centric kernels of the fast steppers (internal): the explicit step, and the backward-
-// Euler linearisation and matrix-vector product. One body (gather_kernel_body.inc), written against
-// a small set of vector operations, instantiated for a portable lane-array set (any CPU) and on
-// x86 for AVX2 (float 8 lanes, double 4) and AVX-512 (float 16); `Kernels` picks one at run time.
+// The node-centric kernels of the fast steppers (internal): the explicit step, the RK4 stage, and
+// the backward-Euler linearisation and matrix-vector product. One body (gather_kernel_body.inc),
+// written against a small set of vector operations, instantiated for a portable lane-array set (any
+// CPU) and on x86 for AVX2 (float 8 lanes, double 4) and AVX-512 (float 16); `Kernels` picks one at
+// run time.
 
 #include <cmath>
 #include <type_traits>
@@ -20,6 +21,10 @@
 #endif
 
 namespace msfem::massspring::detail {
+
+// Which stage of an RK4 step a kernel pass runs: the first reads its state from the step's start
+// and starts the combination, the last finishes it and has no next stage to write.
+enum class RkStage { first, middle, last };
 
 // W lanes as a plain array; the compiler vectorises what it can. Same results as the x86 sets up
 // to rounding (an exact 1/√ here).
@@ -172,6 +177,20 @@ class Kernels {
     if (!symplectic) return explicit_step_damped<false>(g, cur, next, begin, end, h);
     return explicit_step_damped<true>(g, cur, next, begin, end, h);
   }
+  // One stage of classical RK4 (rk4_stage_chunks): `out` the next stage's state, `acc` the running
+  // combination; c and w the stage's h-scaled step to the next stage and weight.
+  double rk4_stage(const NodeGatherLayout<Real, W>& g, RkStage stage, const Real* in,
+                   const Real* base, Real* out, Real* acc, int begin, int end, Real c,
+                   Real w) const {
+    switch (stage) {
+      case RkStage::first:
+        return rk4_stage_damped<RkStage::first>(g, in, base, out, acc, begin, end, c, w);
+      case RkStage::middle:
+        return rk4_stage_damped<RkStage::middle>(g, in, base, out, acc, begin, end, c, w);
+      default:
+        return rk4_stage_damped<RkStage::last>(g, in, base, out, acc, begin, end, c, w);
+    }
+  }
   void linearise_start(const NodeGatherLayout<Real, W>& g, const Real* records,
                        const Real* dv_records, ImplicitCoefficients<Real>& sys,
                        const CgVectors<Real>& cg, Real* p_records, int begin, int end, Real h,
@@ -235,6 +254,36 @@ class Kernels {
 #endif
     return explicit_chunks_portable<PortableLanes<Real, W>, Damped, Symplectic>(g, cur, next, begin,
                                                                                 end, h);
+  }
+  template <RkStage Stage>
+  double rk4_stage_damped(const NodeGatherLayout<Real, W>& g, const Real* in, const Real* base,
+                          Real* out, Real* acc, int begin, int end, Real c, Real w) const {
+    switch (g.spring_damping) {
+      case SpringDamping::none:
+        return rk4_stage_for<SpringDamping::none, Stage>(g, in, base, out, acc, begin, end, c, w);
+      case SpringDamping::uniform:
+        return rk4_stage_for<SpringDamping::uniform, Stage>(g, in, base, out, acc, begin, end, c,
+                                                            w);
+      default:
+        return rk4_stage_for<SpringDamping::per_spring, Stage>(g, in, base, out, acc, begin, end, c,
+                                                               w);
+    }
+  }
+  template <SpringDamping Damped, RkStage Stage>
+  double rk4_stage_for(const NodeGatherLayout<Real, W>& g, const Real* in, const Real* base,
+                       Real* out, Real* acc, int begin, int end, Real c, Real w) const {
+#if MSFEM_HAVE_X86_DISPATCH
+    if constexpr (W == 16) {
+      return rk4_stage_chunks_avx512<Avx512Float, Damped, Stage>(g, in, base, out, acc, begin, end,
+                                                                 c, w);
+    } else if constexpr (W == 32 / sizeof(Real)) {
+      if (avx2_)
+        return rk4_stage_chunks_avx2<Avx2<Real>, Damped, Stage>(g, in, base, out, acc, begin, end,
+                                                                c, w);
+    }
+#endif
+    return rk4_stage_chunks_portable<PortableLanes<Real, W>, Damped, Stage>(g, in, base, out, acc,
+                                                                            begin, end, c, w);
   }
   template <SpringDamping Damped>
   void linearise_start_for(const NodeGatherLayout<Real, W>& g, const Real* records,

@@ -209,29 +209,25 @@ TEST(CaseSettings, EveryIntegratorIsTheOneTimed) {
     if (kind == massspring::IntegratorKind::implicit_euler) {
       EXPECT_EQ(t.stable_dt_s, 1e-3);
     }
-    // On the code a simulator runs: the fast kernels for the schemes they have.
-    using K = massspring::IntegratorKind;
-    const bool fast_explicit =
-        kind == K::symplectic_euler || kind == K::central_difference || kind == K::explicit_euler;
-    EXPECT_EQ(t.stepper, fast_explicit               ? "fast_explicit"
-                         : kind == K::implicit_euler ? "fast_implicit"
-                                                     : "generic")
+    // On the code a simulator runs: the fast kernels, explicit or implicit.
+    EXPECT_EQ(t.stepper, kind == massspring::IntegratorKind::implicit_euler ? "fast_implicit"
+                                                                            : "fast_explicit")
         << name_of(kind);
   }
-  // A force field (the contact tool) keeps the explicit schemes on the fast kernels; implicit
-  // Euler, whose fast kernels do not have fields, runs on the generic integrator.
+  // A force field (the contact tool) keeps every scheme on the fast kernels.
   const Problem pressed = make_problem(with({"loads/tool/mode=contact"}));
   const auto mesh = mesh_problem(pressed);
   const BuiltVariant contact =
       build_variant(cases::Variant::single_layer, pressed, mesh, pressed.tools.front());
   ASSERT_FALSE(contact.model->fields().empty());
-  for (const auto kind : {massspring::IntegratorKind::central_difference,
-                          massspring::IntegratorKind::implicit_euler}) {
+  for (const auto kind :
+       {massspring::IntegratorKind::central_difference, massspring::IntegratorKind::rk4,
+        massspring::IntegratorKind::implicit_euler}) {
     cases::TimingParameters timing = with({"timing/integrator=" + name_of(kind)}).timing;
     timing.steps = 50;
     const Timing t = time_variant(contact, timing, contact.model->initial_state(), false);
-    EXPECT_EQ(t.stepper,
-              kind == massspring::IntegratorKind::implicit_euler ? "generic" : "fast_explicit");
+    EXPECT_EQ(t.stepper, kind == massspring::IntegratorKind::implicit_euler ? "fast_implicit"
+                                                                            : "fast_explicit");
   }
 }
 

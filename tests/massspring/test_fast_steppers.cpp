@@ -74,7 +74,7 @@ TEST(FastExplicitStepper, MatchesExplicitEulerOnTheSameKernels) {
   for (int threads : {1, 2}) {
     FastStepperOptions options;
     options.threads = threads;
-    options.symplectic = false;
+    options.integrator = IntegratorKind::explicit_euler;
     FastExplicitStepper fast(model, options);
     fast.step(dt, 40);
     fast.step(dt, 60);

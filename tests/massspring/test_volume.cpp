@@ -202,8 +202,8 @@ TEST(VolumeForceField, SmallButWellShapedTetrahedraOfAGradedMeshAreKept) {
 }
 
 // The fast steppers step the volume elements as the generic integrators do (a squeezed start, so
-// that they push): symplectic and explicit Euler on the explicit kernels, backward Euler on the
-// implicit ones with the elements' definite Jacobian in its products and preconditioner.
+// that they push): symplectic Euler, explicit Euler and RK4 on the explicit kernels, backward Euler
+// on the implicit ones with the elements' definite Jacobian in its products and preconditioner.
 TEST(VolumeForceField, FastSteppersStepTheVolumeAsTheGenericIntegrators) {
   const SpringNetwork network = three_tier_sphere(1);
   const int nv = static_cast<int>(network.surface_nodes.size());
@@ -270,12 +270,25 @@ TEST(VolumeForceField, FastSteppersStepTheVolumeAsTheGenericIntegrators) {
   for (int n = 0; n < 200; ++n)
     euler_integrator.step(model, euler, dt);
   FastStepperOptions options{2, false, true, true};
-  options.symplectic = false;
+  options.integrator = IntegratorKind::explicit_euler;
   FastExplicitStepper fast_euler(model, options);
   fast_euler.set_state(start);
   fast_euler.step(dt, 200);
   EXPECT_LT((fast_euler.state().x - euler.x).norm(), 1e-9 * travel);
   EXPECT_LT((fast_euler.state().v - euler.v).norm(), 1e-9 * euler.v.norm());
+
+  // RK4: the volume force at each stage's state, its elements shared by the two threads.
+  State rk4 = start;
+  Integrator rk4_integrator(IntegratorKind::rk4);
+  for (int n = 0; n < 200; ++n)
+    rk4_integrator.step(model, rk4, dt);
+  options.integrator = IntegratorKind::rk4;
+  FastExplicitStepper fast_rk4(model, options);
+  fast_rk4.set_state(start);
+  fast_rk4.step(dt, 200);
+  EXPECT_LT((fast_rk4.state().x - rk4.x).norm(), 1e-9 * travel);
+  EXPECT_LT((fast_rk4.state().v - rk4.v).norm(), 1e-9 * rk4.v.norm());
+  EXPECT_GT((rk4.x - generic.x).norm(), 1e-4 * travel);  // not symplectic Euler's states
 }
 
 }  // namespace

@@ -13,9 +13,11 @@ struct FastStepperOptions {
   bool single_precision = false;  ///< float arithmetic (twice the SIMD width, ~1e-7 relative)
   bool reorder_nodes = true;      ///< reverse Cuthill-McKee order for memory locality
   bool allow_avx512 = true;       ///< float: 16 lanes where the CPU has AVX-512 (else 8, AVX2)
-  /// false: explicit (forward) Euler, x ← x + h v with the step's starting v, on the same kernels
-  /// (the generic Integrator's explicit_euler, at the speed of the symplectic step).
-  bool symplectic = true;
+  /// The scheme, as the generic Integrator of the same kind steps it: symplectic_euler,
+  /// explicit_euler (x ← x + h v with the step's starting v, at the symplectic step's cost) or rk4
+  /// (four force passes a step). Others throw ModelError; central_difference is symplectic_euler
+  /// with velocities read at half steps.
+  IntegratorKind integrator = IntegratorKind::symplectic_euler;
   /// Each step(dt, count) call on the whole team or on the calling thread alone, whichever took
   /// less time per step lately (re-checked by 4 calls on the other count after every 32 to 256):
   /// on a machine whose cores other jobs hold, a small model's barrier waits make two threads
@@ -27,23 +29,25 @@ struct FastStepperOptions {
 /// The real-time explicit stepper: symplectic Euler, which with velocities read at half steps is
 /// the central-difference (leapfrog) scheme of the pancreas paper,
 ///   v ← v + h M⁻¹ f(x, v),   x ← x + h v,
-/// or explicit Euler (FastStepperOptions::symplectic off: x advances with the step's starting v),
-/// on the model's springs, dampers, node damping, gravity, external forces and supports, and its
-/// force fields (the tool's contact, volume preservation): each step adds a field's force, taken
-/// from the step's start like the springs', to the field's free nodes after the spring kernels. A
-/// field on a few nodes costs a step little; one on every node (volume preservation) runs on the
-/// calling thread. The model must outlive the stepper.
+/// explicit Euler (x advances with the step's starting v) or classical RK4 (FastStepperOptions::
+/// integrator), on the model's springs, dampers, node damping, gravity, external forces and
+/// supports, and its force fields (the tool's contact, volume preservation): each force pass adds
+/// a field's force, taken at the same state as the springs', to the field's free nodes after the
+/// spring kernels, the members sharing the field's work (ForceField::add_force_part). The model
+/// must outlive the stepper.
 ///
 /// Layout: nodes renumbered by reverse Cuthill-McKee with the constrained ones last (never
 /// updated); x and v of a node packed in one record. Each step is node-centric: every free node
 /// gathers its own springs' forces from its neighbours' records of the previous step and writes its
 /// new x and v to a second buffer (double buffering), so a step has no scatter, no force buffers to
-/// sum and one barrier. Springs are stored per node in vector-width chunks (sliced ELLPACK) with
-/// their k and k l0 (and c, unless one damping serves all springs) beside the neighbour index. Each
-/// spring is evaluated twice, once per end: more arithmetic for far less memory traffic. Threads
-/// take blocks of chunks from a shared counter, so a thread the OS pre-empts delays a step by one
-/// block. The kernels (gather_kernels.hpp) are compiled for baseline x86-64, AVX2+FMA (float 8
-/// lanes, double 4) and AVX-512 (float 16, while the model fits in cache) and picked at run time.
+/// sum and one barrier. RK4 is four such passes, one per stage, each reading the stage state the
+/// last one wrote (two more buffers) and a barrier apart. Springs are stored per node in
+/// vector-width chunks (sliced ELLPACK) with their k and k l0 (and c, unless one damping serves all
+/// springs) beside the neighbour index. Each spring is evaluated twice, once per end: more
+/// arithmetic for far less memory traffic. Threads take blocks of chunks from a shared counter, so
+/// a thread the OS pre-empts delays a step by one block. The kernels (gather_kernels.hpp) are
+/// compiled for baseline x86-64, AVX2+FMA (float 8 lanes, double 4) and AVX-512 (float 16, while
+/// the model fits in cache) and picked at run time.
 class FastExplicitStepper {
  public:
   explicit FastExplicitStepper(const MassSpringModel& model,
@@ -70,7 +74,8 @@ class FastExplicitStepper {
   int last_step_threads() const;
   /// Bytes a spring step streams at the least: every slot's neighbour index, k, k l0 (and c), every
   /// lane's index and per-node coefficients, and the node records read and written once, as if
-  /// every neighbour's record were a cache hit. With steps per second, the memory bandwidth a step
+  /// every neighbour's record were a cache hit (RK4: four such passes, each also reading and
+  /// writing its stage and combination records). With steps per second, the memory bandwidth a step
   /// uses (the roofline of a memory-bound kernel).
   std::size_t streamed_bytes_per_step() const;
 

@@ -90,8 +90,8 @@ StaticSolution solve_variant_static(const BuiltVariant& variant,
 
 struct Timing {
   std::string integrator;  ///< the timed integrator's name; empty when not timed
-  /// The code timed: fast_explicit (FastExplicitStepper), fast_implicit (FastImplicitStepper)
-  /// or generic (Integrator: explicit Euler, RK4, implicit Euler with a force field).
+  /// The code timed: fast_explicit (FastExplicitStepper: explicit and symplectic Euler, central
+  /// difference, RK4) or fast_implicit (FastImplicitStepper: implicit Euler).
   std::string stepper;
   double dt_s = 0.0;              ///< step used for steps/s and settling
   double steps_per_second = 0.0;  ///< median over batches after warm-up
