@@ -193,6 +193,28 @@ PrecisionComparison compare_precision(const MassSpringModel& model, double dt, i
   return c;
 }
 
+namespace {
+
+// Explicit Euler and RK4 on the fast explicit kernels, as a simulator (and msfem sweep) runs them.
+void time_other_integrators(const MassSpringModel& model, const State& start,
+                            FastStepperOptions fast_options,
+                            const SteppingBenchmarkOptions& options,
+                            SteppingBenchmarkResult& result) {
+  fast_options.integrator = IntegratorKind::explicit_euler;
+  FastExplicitStepper euler(model, fast_options);
+  euler.set_state(start);
+  result.explicit_euler_spread = rate_spread([&](int n) { euler.step(result.explicit_dt, n); },
+                                             options.steps_per_call, options);
+  fast_options.integrator = IntegratorKind::rk4;
+  FastExplicitStepper rk4(model, fast_options);
+  rk4.set_state(start);
+  result.rk4_dt = 0.5 * predicted_stable_dt(model, IntegratorKind::rk4, model.initial_state());
+  result.rk4_spread =
+      rate_spread([&](int n) { rk4.step(result.rk4_dt, n); }, options.steps_per_call, options);
+}
+
+}  // namespace
+
 SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
                                                const SteppingBenchmarkOptions& options) {
   SteppingBenchmarkResult result;
@@ -214,6 +236,8 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
                                        options.steps_per_call, options);
   result.explicit_steps_per_second = result.explicit_spread.median;
   result.explicit_last_step_threads = fast.last_step_threads();
+  if (options.run_other_integrators)
+    time_other_integrators(model, start, fast_options, options, result);
   const bool fields = !model.fields().empty();
   if (fields)
     result.notes.push_back(

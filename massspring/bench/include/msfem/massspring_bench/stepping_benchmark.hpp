@@ -42,6 +42,9 @@ struct SteppingBenchmarkOptions {
   int samples = 5;                  ///< the median is reported
   bool run_naive = true;
   bool run_implicit = true;
+  /// Also explicit Euler and RK4 on the fast explicit kernels (central difference is the
+  /// symplectic Euler step with velocities read at half steps: the same figure).
+  bool run_other_integrators = true;
   double implicit_dt = 1e-3;            ///< haptic rate
   double implicit_cg_tolerance = 1e-2;  ///< FastImplicitOptions' haptic default
   int implicit_cg_max_iterations = 50;
@@ -77,6 +80,8 @@ struct SteppingBenchmarkResult {
   double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
   RateSpread explicit_spread, naive_spread, implicit_spread;
+  RateSpread explicit_euler_spread, rk4_spread;  ///< at explicit_dt (rk4: its own half stable step)
+  double rk4_dt = 0.0;
   std::size_t explicit_bytes_per_step = 0;
   int explicit_last_step_threads = 0;  ///< where adaptive threads ended (1 or threads)  ///<
                                        ///< FastExplicitStepper::streamed_bytes_per_step
