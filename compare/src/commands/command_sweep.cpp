@@ -138,19 +138,21 @@ int sweep_command(const Arguments& args) {
   const std::filesystem::path cache = fem_cache_beside(final_dir);
   std::ostringstream printed;
   std::vector<std::pair<int, std::string>> failed;
+  std::vector<SweepResult::FailedVariant> failed_variants;
   // Under mpirun every rank sweeps (the FEM and the timed items are shared) and rank 0 writes.
   const bool writes = ranks::is_root();
   ranks::agree([&] {
     if (writes) check_output_folder(final_dir);
   });
   if (!writes) {
-    failed = run_sweep(parameters, settings, cache).failed_resolutions;
-    return failed.empty() ? 0 : 1;
+    const SweepResult result = run_sweep(parameters, settings, cache);
+    return result.failed_resolutions.empty() && result.failed_variants.empty() ? 0 : 1;
   }
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work) {
     const SweepResult result = run_sweep(parameters, settings, cache);
     const auto& points = result.points;
     failed = result.failed_resolutions;
+    failed_variants = result.failed_variants;
     const nlohmann::json j = sweep_json(parameters, result);
     write_text_atomically(work / "sweep.json", j.dump(2) + "\n");
     std::string plot_line = "(plots skipped: gnuplot is not installed)";
@@ -177,6 +179,9 @@ int sweep_command(const Arguments& args) {
     for (const auto& [resolution, why] : result.failed_resolutions)
       table += "\n> **resolution " + std::to_string(resolution) +
                " failed** and is left out of the table and plot: " + why + "\n";
+    for (const auto& f : result.failed_variants)
+      table += "\n> **" + f.model + " failed at resolution " + std::to_string(f.resolution) +
+               "** and is left out of the table and plot: " + f.error + "\n";
     write_text_atomically(work / "report.md",
                           "# msfem sweep: " + parameters.name + "\n\n" + answer +
                               convergence_section(convergence) + "## Every configuration\n\n" +
@@ -191,10 +196,13 @@ int sweep_command(const Arguments& args) {
                     : table + "\n" + answer + "results in " + final_dir.string() + "\n");
   });
   std::cout << printed.str();
-  // The sweep's other resolutions are written; a script still learns that one is missing.
+  // The sweep's other resolutions and variants are written; a script still learns what is missing.
   for (const auto& [resolution, why] : failed)
     std::cerr << "msfem sweep: resolution " << resolution << " failed: " << why << "\n";
-  return failed.empty() ? 0 : 1;
+  for (const auto& f : failed_variants)
+    std::cerr << "msfem sweep: resolution " << f.resolution << ": variant " << f.model
+              << " failed: " << f.error << "\n";
+  return failed.empty() && failed_variants.empty() ? 0 : 1;
 }
 
 }  // namespace msfem::compare

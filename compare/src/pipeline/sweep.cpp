@@ -193,7 +193,8 @@ struct SweepPass {
 // the same time, one per rank: each timing is single-threaded on its rank's own core.
 std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
                                          const SweepSettings& settings, const SweepPass& pass,
-                                         const std::filesystem::path& fem_cache_directory) {
+                                         const std::filesystem::path& fem_cache_directory,
+                                         std::vector<SweepResult::FailedVariant>& failed) {
   cases::CaseParameters p = at_resolution(parameters, resolution);
   const bool volume = pass.volume;
   p.mass_spring.volume_preservation = volume;
@@ -209,6 +210,13 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
   run_settings.all_tools = false;  // accuracy against speed at the case's first tool
   run_settings.fem_cache_directory = fem_cache_directory;
   const CaseRun run = run_case(p, run_settings);
+  for (const auto& [name, why] : run.failed_variants) {
+    SweepPoint named;
+    named.variant = name;
+    named.volume_preservation = volume;
+    if (run.problem.local_refinement) named.contact_edge_m = run.problem.local_refinement->edge_m;
+    failed.push_back({resolution, named.model(), why});
+  }
   std::vector<std::pair<std::size_t, massspring::IntegratorKind>> items;
   for (std::size_t v = 0; v < run.variants.size(); ++v)
     if (!volume || run.variants[v].parameters.contains("volume_preservation"))
@@ -260,12 +268,17 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
     try {
       // All of a resolution's points or none of them.
       std::vector<SweepPoint> more;
+      std::vector<SweepResult::FailedVariant> failed;
       for (const SweepPass& pass : passes) {
-        const std::vector<SweepPoint> swept =
-            sweep_resolution(parameters, resolutions[r], settings, pass, fem_cache_directory);
+        const std::vector<SweepPoint> swept = sweep_resolution(parameters, resolutions[r], settings,
+                                                               pass, fem_cache_directory, failed);
         more.insert(more.end(), swept.begin(), swept.end());
       }
       points.insert(points.end(), more.begin(), more.end());
+      for (const auto& f : failed)
+        progress.stage("sweep resolution " + std::to_string(f.resolution) + ": variant " + f.model +
+                       " failed: " + f.error);
+      result.failed_variants.insert(result.failed_variants.end(), failed.begin(), failed.end());
     } catch (const std::exception& e) {
       if (!first_failure) first_failure = std::current_exception();
       result.failed_resolutions.emplace_back(resolutions[r], e.what());
@@ -288,12 +301,17 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
   nlohmann::json failed = nlohmann::json::array();
   for (const auto& [resolution, why] : result.failed_resolutions)
     failed.push_back({{"resolution", resolution}, {"error", why}});
+  nlohmann::json failed_variants = nlohmann::json::array();
+  for (const auto& f : result.failed_variants)
+    failed_variants.push_back(
+        {{"resolution", f.resolution}, {"variant", f.model}, {"error", f.error}});
   return {{"case", parameters.name},
           {"git_revision", git_revision()},
           {"machine", machine_description()},
           {"units", {{"length", "m"}, {"time", "s"}}},
           {"points", list},
-          {"failed_resolutions", failed}};
+          {"failed_resolutions", failed},
+          {"failed_variants", failed_variants}};
 }
 
 std::string sweep_table(const std::vector<SweepPoint>& points) {

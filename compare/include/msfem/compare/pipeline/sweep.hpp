@@ -54,6 +54,13 @@ struct SweepResult {
   /// Resolutions that could not be run (e.g. the brain simplified below ~2,500 vertices
   /// self-intersects in its sulci), with the reason; the others are still swept.
   std::vector<std::pair<int, std::string>> failed_resolutions;
+  /// Variants whose statics failed at a resolution (a solver, not the input: e.g. a shell with no
+  /// stable equilibrium at the tool's depth), as msfem run reports them; the others are swept.
+  struct FailedVariant {
+    int resolution = 0;
+    std::string model, error;  ///< the model as SweepPoint::model() names it
+  };
+  std::vector<FailedVariant> failed_variants;
 };
 
 /// Runs the sweep (the FEM once per resolution, through the cache when given). Throws when no
