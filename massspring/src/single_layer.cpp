@@ -39,7 +39,11 @@ SpringNetwork build_single_layer(const Eigen::MatrixX3d& vertices,
     }
     network.anchor_node = Eigen::VectorXi::LinSpaced(nv, 0, nv - 1);
     network.anchor_point = vertices;
-    network.anchor_stiffness = options.anchor_ratio * summed;
+    // Weighted by the node's share of the area: the anchors stand for an elastic foundation, whose
+    // stiffness per unit area must not grow where the surface is finer (a refined patch at the
+    // tool, a simplified organ's small triangles), while the edges' summed stiffness stays about
+    // the same at any edge length (the network rule's k does not depend on it).
+    network.anchor_stiffness = options.anchor_ratio * summed.cwiseProduct(areas / areas.mean());
     network.anchor_damping = Eigen::VectorXd::Zero(nv);
   } else {
     network.anchor_node.resize(0);

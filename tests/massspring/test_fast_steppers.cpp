@@ -258,7 +258,8 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   EXPECT_GT(result.naive_steps_per_second, 0.0);
   EXPECT_GT(result.implicit_steps_per_second, 0.0);
   for (const RateSpread* s :
-       {&result.explicit_spread, &result.naive_spread, &result.implicit_spread}) {
+       {&result.explicit_spread, &result.naive_spread, &result.implicit_spread,
+        &result.explicit_euler_spread, &result.rk4_spread}) {
     EXPECT_GT(s->min, 0.0);
     EXPECT_LE(s->min, s->median);
     EXPECT_LE(s->median, s->max);

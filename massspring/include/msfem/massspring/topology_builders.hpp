@@ -82,7 +82,8 @@ std::vector<int> inverted_tier_prisms(const Eigen::MatrixX3d& outer, const Eigen
 /// --- single_layer ---
 /// Surface edges only (group "surface_edges"). With anchor_to_rest, every node is also tied to its
 /// rest position by a zero-length spring of stiffness anchor_ratio × the summed stiffness of its
-/// edges (the usual fix when no surface node is supported; drop it when supports exist).
+/// edges × its area over the mean vertex area (the usual fix when no surface node is supported;
+/// drop it when supports exist).
 struct SingleLayerOptions {
   bool anchor_to_rest = true;
   double anchor_ratio = 0.1;

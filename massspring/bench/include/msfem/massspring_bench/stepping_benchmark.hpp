@@ -80,8 +80,7 @@ struct SteppingBenchmarkResult {
   double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
   RateSpread explicit_spread, naive_spread, implicit_spread;
-  RateSpread explicit_euler_spread, rk4_spread;  ///< at explicit_dt (rk4: its own half stable step)
-  double rk4_dt = 0.0;
+  RateSpread explicit_euler_spread, rk4_spread;  ///< at explicit_dt / 100
   std::size_t explicit_bytes_per_step = 0;
   int explicit_last_step_threads = 0;  ///< where adaptive threads ended (1 or threads)  ///<
                                        ///< FastExplicitStepper::streamed_bytes_per_step
