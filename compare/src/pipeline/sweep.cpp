@@ -152,16 +152,17 @@ void share_points(std::vector<SweepPoint>& points, const std::vector<bool>& mine
 
 // Which rank times each (variant, integrator) item: the costliest first, each to the rank with the
 // least work so far. A timing costs about the model's nodes times its integrator's price per step
-// (implicit Euler's CG solve some 30-200 explicit steps on the sphere, RK4's four force evaluations
-// 3-7): dealt round-robin, four integrators on two ranks would give one rank every implicit item.
+// (on the fast kernels, in contact, implicit Euler's warm-started CG step some 3-9 symplectic steps
+// on the sphere, RK4's four force passes 4-9): dealt round-robin, four integrators on two ranks
+// would give one rank every costly item.
 std::vector<int> owners(
     const CaseRun& run,
     const std::vector<std::pair<std::size_t, massspring::IntegratorKind>>& items) {
   std::vector<double> cost(items.size());
   for (std::size_t j = 0; j < items.size(); ++j) {
     const massspring::IntegratorKind k = items[j].second;
-    const double price = k == massspring::IntegratorKind::implicit_euler ? 100.0
-                         : k == massspring::IntegratorKind::rk4          ? 5.0
+    const double price = k == massspring::IntegratorKind::implicit_euler ? 6.0
+                         : k == massspring::IntegratorKind::rk4          ? 6.0
                                                                          : 1.0;
     cost[j] = price * run.variants[items[j].first].nodes;
   }
