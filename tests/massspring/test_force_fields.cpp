@@ -75,6 +75,26 @@ MassSpringModel three_tier_model() {
   return model;
 }
 
+// The three tiers held at their core, under gravity, tied to rest by a tether with a dashpot.
+MassSpringModel tethered_model() {
+  MassSpringModel model = three_tier_model();
+  const Eigen::VectorXd rest = model.rest_state();
+  for (int node = 0; node < model.num_nodes(); ++node)
+    if (rest.segment<3>(3 * node).norm() < 0.03) model.fix_node(node);
+  model.set_gravity(Eigen::Vector3d(0, 0, -9.81));
+  model.set_field("tether", std::make_shared<RestTether>(rest, 50.0, 0.02));
+  return model;
+}
+
+// Rest, with a fixed pseudo-random velocity on the free nodes.
+State moving_start(const MassSpringModel& model) {
+  State start = initial_state(model);
+  start.v.setRandom();
+  start.v *= 0.01;
+  model.zero_constrained(start.v);
+  return start;
+}
+
 TEST(ForceFields, AFieldJoinsEveryForceModelCall) {
   MassSpringModel model = three_tier_model();
   const Eigen::VectorXd rest = model.rest_state();
@@ -134,21 +154,13 @@ TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByName) {
   EXPECT_NE(model.volume(), nullptr);
 }
 
-// The fast explicit stepper steps a model's fields as the generic symplectic Euler does (a
-// tether with a dashpot: it reads x and v); the fast implicit one, whose kernels do not have them,
-// refuses the model by the field's name. The linearised statics give each field its own weight.
+// The fast steppers step a model's fields as the generic integrators do (a tether with a dashpot:
+// it reads x and v): symplectic Euler on the explicit kernels, backward Euler on the implicit ones
+// with the tether's Jacobians. The linearised statics give each field its own weight.
 TEST(ForceFields, FastSteppersStepFieldsAndLinearStaticsWeighEach) {
-  MassSpringModel model = three_tier_model();
+  MassSpringModel model = tethered_model();
   const Eigen::VectorXd rest = model.rest_state();
-  for (int node = 0; node < model.num_nodes(); ++node)
-    if (rest.segment<3>(3 * node).norm() < 0.03) model.fix_node(node);
-  model.set_gravity(Eigen::Vector3d(0, 0, -9.81));
-  model.set_field("tether", std::make_shared<RestTether>(rest, 50.0, 0.02));
-  State start = initial_state(model);
-  start.v.setRandom();
-  start.v *= 0.01;
-  for (int node = 0; node < model.num_nodes(); ++node)
-    if (model.is_constrained(node)) start.v.segment<3>(3 * node).setZero();
+  const State start = moving_start(model);
   State generic = start;
   FastExplicitStepper fast(model, FastStepperOptions{2, false, true, true});
   fast.set_state(start);
@@ -205,16 +217,8 @@ TEST(ForceFields, FastSteppersStepFieldsAndLinearStaticsWeighEach) {
 // RK4 takes the field at each of its four stages, at that stage's x and v, as the generic RK4
 // does: with a force applied once a step the states would part at first order in the step.
 TEST(ForceFields, FastRk4TakesTheFieldAtEveryStage) {
-  MassSpringModel model = three_tier_model();
-  const Eigen::VectorXd rest = model.rest_state();
-  for (int node = 0; node < model.num_nodes(); ++node)
-    if (rest.segment<3>(3 * node).norm() < 0.03) model.fix_node(node);
-  model.set_gravity(Eigen::Vector3d(0, 0, -9.81));
-  model.set_field("tether", std::make_shared<RestTether>(rest, 50.0, 0.02));
-  State start = initial_state(model);
-  start.v.setRandom();
-  start.v *= 0.01;
-  model.zero_constrained(start.v);
+  MassSpringModel model = tethered_model();
+  const State start = moving_start(model);
   State generic = start;
   Integrator integrator(IntegratorKind::rk4);
   const double dt = 2e-5;
