@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -170,6 +171,41 @@ TEST(CliMpi, CalibrateSharesTheLoadsAndFitsAsOneRank) {
   int compared = 0;
   expect_same_numbers(a, b, "calibration.json", 1e-5, compared);
   EXPECT_GT(compared, 30);
+}
+
+// msfem regress on two ranks: the ranks share each case, rank 0 prints one table and writes every
+// baseline, and the baselines are the one-rank ones.
+TEST(CliMpi, RegressOnTwoRanksWritesTheOneRankBaselines) {
+  const std::string mpirun = find_mpirun();
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";
+  TemporaryDirectory tmp;
+  const std::string text = read_text(std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm");
+  std::string cases;
+  for (const char* name : {"first", "second"}) {
+    std::ofstream(tmp / (std::string(name) + ".prm")) << text;
+    cases += " " + (tmp / (std::string(name) + ".prm")).string();
+  }
+  const std::string update = "regress" + cases + " --quiet --update --baselines ";
+  const auto alone = run_msfem(update + (tmp / "one").string());
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const auto shared = run_msfem_on_two_ranks(mpirun, update + (tmp / "two").string());
+  ASSERT_EQ(shared.exit_code, 0) << shared.err;
+  for (const char* name : {"first", "second"}) {
+    EXPECT_EQ(occurrences(shared.out, "/" + std::string(name) + ".json:"), 1u) << shared.out;
+    const auto a = nlohmann::json::parse(read_text(tmp / "one" / (std::string(name) + ".json")));
+    const auto b = nlohmann::json::parse(read_text(tmp / "two" / (std::string(name) + ".json")));
+    EXPECT_TRUE(std::filesystem::exists(tmp / "two" / (std::string(name) + ".fields.h5")));
+    int compared = 0;
+    expect_same_numbers(a["variants"], b["variants"], name, 1e-6, compared);
+    EXPECT_GT(compared, 20);
+  }
+  // The two-rank baselines pass against the one-rank run, and the table is printed once.
+  const auto check = run_msfem_on_two_ranks(
+      mpirun, "regress" + cases + " --quiet --baselines " + (tmp / "one").string());
+  EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+  EXPECT_EQ(occurrences(check.out, "regress: "), 1u) << check.out;
+  EXPECT_EQ(occurrences(check.out, " 0 failed"), 1u) << check.out;
+  EXPECT_GT(occurrences(check.out, "second"), 0u) << check.out;
 }
 
 TEST(CliMpi, BadInputOnTwoRanksExitsTwoOnceAndWritesNothing) {

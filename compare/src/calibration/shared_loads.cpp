@@ -2,7 +2,6 @@
 #include "calibration/shared_loads.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <tuple>
@@ -60,10 +59,9 @@ std::vector<LoadErrors> shared_errors(std::size_t loads,
       break;
     }
   }
-  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(own);
   std::vector<std::tuple<std::size_t, std::string, bool>> failures;
-  for (const std::string& part : ranks::gather_on_all(std::string(bytes.begin(), bytes.end())))
-    for (const auto& entry : nlohmann::json::from_cbor(part)) {
+  for (const nlohmann::json& part : ranks::gather_json_on_all(own))
+    for (const auto& entry : part) {
       const auto i = entry.at("i").get<std::size_t>();
       if (entry.contains("failure"))
         failures.emplace_back(i, entry.at("failure").get<std::string>(),
@@ -85,10 +83,9 @@ std::vector<Eigen::VectorXd> shared_equilibria(const std::vector<Eigen::VectorXd
     if (owns_load(i))
       own.push_back(
           {{"i", i}, {"x", std::vector<double>(mine[i].data(), mine[i].data() + mine[i].size())}});
-  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(own);
   std::vector<Eigen::VectorXd> x(mine.size());
-  for (const std::string& part : ranks::gather_on_all(std::string(bytes.begin(), bytes.end())))
-    for (const auto& entry : nlohmann::json::from_cbor(part)) {
+  for (const nlohmann::json& part : ranks::gather_json_on_all(own))
+    for (const auto& entry : part) {
       const auto values = entry.at("x").get<std::vector<double>>();
       x[entry.at("i").get<std::size_t>()] = Eigen::Map<const Eigen::VectorXd>(
           values.data(), static_cast<Eigen::Index>(values.size()));

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -104,6 +105,35 @@ int index() {
   return r;
 }
 
+std::vector<int> deal(const std::vector<double>& cost, int ranks) {
+  std::vector<std::size_t> order(cost.size());
+  for (std::size_t j = 0; j < order.size(); ++j)
+    order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
+  std::vector<double> work(static_cast<std::size_t>(std::max(ranks, 1)), 0.0);
+  std::vector<int> owner(cost.size(), 0);
+  for (const std::size_t j : order) {
+    const auto least = std::min_element(work.begin(), work.end());
+    owner[j] = static_cast<int>(least - work.begin());
+    *least += cost[j];
+  }
+  return owner;
+}
+
+int on_this_machine() {
+  if (count() == 1) return 1;
+  static const int ranks = [] {
+    MPI_Comm machine = MPI_COMM_NULL;
+    MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &machine);
+    int n = 1;
+    MPI_Comm_size(machine, &n);
+    MPI_Comm_free(&machine);
+    return n;
+  }();
+  return ranks;
+}
+
 void start_if_launched() {
   if (!launched() || running()) return;
   int provided = 0;
@@ -159,6 +189,14 @@ std::vector<std::string> gather_on_all(const std::string& bytes) {
   if (count() == 1) return {bytes};
   idle_barrier();
   return all_gather(bytes);
+}
+
+std::vector<nlohmann::json> gather_json_on_all(const nlohmann::json& value) {
+  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(value);
+  std::vector<nlohmann::json> all;
+  for (const std::string& part : gather_on_all(std::string(bytes.begin(), bytes.end())))
+    all.push_back(nlohmann::json::from_cbor(part));
+  return all;
 }
 
 std::string broadcast_from_root(const std::string& bytes) {

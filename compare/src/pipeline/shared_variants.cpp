@@ -1,9 +1,12 @@
 // The spring variants of a run shared across MPI ranks. The unit of work is one variant at one
-// load (its statics along the loading path), dealt round-robin: with the brain's four variants at
-// four tool positions each rank presses every variant at half the positions, so the ranks finish
-// together whatever the variants cost. Each rank builds a variant once for its loads. The timing
+// load (its statics along the loading path), dealt by estimated cost (ranks::deal): the three
+// tiers have three times the nodes of one surface, and at one load (a sweep's resolution) dealing
+// round-robin gave the three tiers and the skeleton to one rank and the single layer alone to the
+// other. Each rank builds a variant once for its loads. The timing
 // (steps per second) runs afterwards on one rank at a time, the others asleep in a barrier, so
 // that no rank competes for the timed rank's core.
+#include <algorithm>
+#include <cmath>
 #include <exception>
 #include <optional>
 
@@ -15,11 +18,36 @@
 namespace msfem::compare::detail {
 namespace {
 
-// Variant v's load k is pressed on this rank; offset by the variant so that the first loads (each
-// carrying its variant's timing) fall on different ranks.
-bool mine(int variant, std::size_t load) {
-  return (static_cast<std::size_t>(variant) + load) % static_cast<std::size_t>(ranks::count()) ==
-         static_cast<std::size_t>(ranks::index());
+// The nodes a variant will have, before it is built: the statics' cost grows with them (sparse
+// Cholesky, about the 1.5th power in a volume).
+double estimated_nodes(const CaseRun& run, cases::Variant kind) {
+  const auto surface = static_cast<double>(run.problem.surface.num_vertices());
+  switch (kind) {
+    case cases::Variant::three_tier:
+      return 3.0 * surface;
+    case cases::Variant::tet_edges:
+      return static_cast<double>(run.mesh.vertices.rows());
+    case cases::Variant::skeleton:
+      return 1.1 * surface;
+    case cases::Variant::single_layer:
+      break;
+  }
+  return surface;
+}
+
+// Whether this rank presses variant v at load k: mine[v][k], dealt by cost, alike on every rank.
+std::vector<std::vector<bool>> this_ranks_items(const CaseRun& run) {
+  const auto& variants = run.problem.parameters.mass_spring.variants;
+  std::vector<double> cost;
+  for (const cases::Variant kind : variants)
+    for (std::size_t k = 0; k < run.loads.size(); ++k)
+      cost.push_back(std::pow(estimated_nodes(run, kind), 1.5));
+  const std::vector<int> owner = ranks::deal(cost);
+  std::vector<std::vector<bool>> mine(variants.size(), std::vector<bool>(run.loads.size()));
+  for (std::size_t v = 0; v < variants.size(); ++v)
+    for (std::size_t k = 0; k < run.loads.size(); ++k)
+      mine[v][k] = owner[v * run.loads.size() + k] == ranks::index();
+  return mine;
 }
 
 struct Pending {
@@ -29,7 +57,8 @@ struct Pending {
 
 // This rank's loads of variant v, in increasing order; a solver's failure ends the variant here.
 // The built variant is kept where it is to be timed.
-Pending press_share(const CaseRun& run, int v, const std::vector<double>& path, bool timed) {
+Pending press_share(const CaseRun& run, int v, const std::vector<bool>& mine,
+                    const std::vector<double>& path, bool timed) {
   const cases::Variant kind = run.problem.parameters.mass_spring.variants[v];
   Pending p;
   p.built = build_variant(kind, run.problem, run.mesh, run.loads.front().tool);
@@ -38,7 +67,7 @@ Pending press_share(const CaseRun& run, int v, const std::vector<double>& path, 
   s.result = variant_header(*p.built);
   s.tetrahedra = p.built->tetrahedra.rows();
   for (std::size_t k = 0; k < run.loads.size(); ++k) {
-    if (!mine(v, k)) continue;
+    if (!mine[k]) continue;
     try {
       s.result.loads.push_back(at_load(run.problem, *p.built, run.loads[k], path));
       s.load_indices.push_back(static_cast<int>(k));
@@ -80,12 +109,12 @@ std::vector<VariantShare> this_ranks_shares(const CaseRun& run, const std::vecto
   const auto start = Clock::now();
   const auto& variants = run.problem.parameters.mass_spring.variants;
   const int total = static_cast<int>(variants.size());
+  const std::vector<std::vector<bool>> mine = this_ranks_items(run);
   try {
     for (int v = 0; v < total; ++v) {
-      bool any = false;
-      for (std::size_t k = 0; k < run.loads.size(); ++k)
-        any = any || mine(v, k);
-      if (any) pending.push_back(press_share(run, v, path, settings.time_dynamics));
+      const std::vector<bool>& loads = mine[static_cast<std::size_t>(v)];
+      if (std::find(loads.begin(), loads.end(), true) != loads.end())
+        pending.push_back(press_share(run, v, loads, path, settings.time_dynamics));
       progress.advance("variant " + cases::name_of(variants[v]) + " (this rank's loads)", v + 1,
                        total, seconds_since(start));
     }

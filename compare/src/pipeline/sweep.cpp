@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "msfem/cases/setting_names.hpp"
@@ -18,7 +19,8 @@
 
 namespace msfem::compare {
 
-std::string SweepPoint::model() const {
+std::string SweepPoint::model_name(const std::string& variant, bool volume_preservation,
+                                   std::optional<double> contact_edge_m) {
   std::string name = volume_preservation ? variant + "+volume" : variant;
   if (contact_edge_m) {
     char edge[48];
@@ -63,7 +65,12 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   timing.integrator = integrator;
   timing.dt_s = 0.0;  // each integrator at half its own stable step
   // From run_case's equilibrium, reached from rest as here.
-  const Timing t = time_variant(built, timing, at_load.equilibrium, /*measure_settling=*/false);
+  // Under mpirun the ranks on a machine time one item each at the same time: each takes its share
+  // of the cores, so that no timed thread waits on a barrier for a thread that has no core.
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = std::max(1, cores / ranks::on_this_machine());
+  const Timing t =
+      time_variant(built, timing, at_load.equilibrium, /*measure_settling=*/false, threads);
   SweepPoint pt;
   pt.variant = v.name;
   pt.integrator = massspring::to_string(integrator);
@@ -144,17 +151,14 @@ void share_points(std::vector<SweepPoint>& points, const std::vector<bool>& mine
   nlohmann::json own = nlohmann::json::array();
   for (std::size_t j = 0; j < points.size(); ++j)
     if (mine[j]) own.push_back({{"item", j}, {"point", point_json(points[j])}});
-  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(own);
-  for (const std::string& part : ranks::gather_on_all(std::string(bytes.begin(), bytes.end())))
-    for (const auto& entry : nlohmann::json::from_cbor(part))
+  for (const nlohmann::json& part : ranks::gather_json_on_all(own))
+    for (const auto& entry : part)
       points[entry.at("item").get<std::size_t>()] = point_from_json(entry.at("point"));
 }
 
-// Which rank times each (variant, integrator) item: the costliest first, each to the rank with the
-// least work so far. A timing costs about the model's nodes times its integrator's price per step
-// (on the fast kernels, in contact, implicit Euler's warm-started CG step some 3-9 symplectic steps
-// on the sphere, RK4's four force passes 4-9): dealt round-robin, four integrators on two ranks
-// would give one rank every costly item.
+// Which rank times each (variant, integrator) item. A timing costs about the model's nodes times
+// its integrator's price per step (on the fast kernels, in contact, implicit Euler's warm-started
+// CG step some 3-9 symplectic steps on the sphere, RK4's four force passes 4-9).
 std::vector<int> owners(
     const CaseRun& run,
     const std::vector<std::pair<std::size_t, massspring::IntegratorKind>>& items) {
@@ -166,19 +170,7 @@ std::vector<int> owners(
                                                                          : 1.0;
     cost[j] = price * run.variants[items[j].first].nodes;
   }
-  std::vector<std::size_t> order(items.size());
-  for (std::size_t j = 0; j < order.size(); ++j)
-    order[j] = j;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
-  std::vector<double> work(static_cast<std::size_t>(ranks::count()), 0.0);
-  std::vector<int> owner(items.size(), 0);
-  for (const std::size_t j : order) {
-    const auto least = std::min_element(work.begin(), work.end());
-    owner[j] = static_cast<int>(least - work.begin());
-    *least += cost[j];
-  }
-  return owner;
+  return ranks::deal(cost);
 }
 
 // One pass's settings beside the resolution: volume preservation and contact refinement.
@@ -211,13 +203,10 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
   run_settings.all_tools = false;  // accuracy against speed at the case's first tool
   run_settings.fem_cache_directory = fem_cache_directory;
   const CaseRun run = run_case(p, run_settings);
-  for (const auto& [name, why] : run.failed_variants) {
-    SweepPoint named;
-    named.variant = name;
-    named.volume_preservation = volume;
-    if (run.problem.local_refinement) named.contact_edge_m = run.problem.local_refinement->edge_m;
-    failed.push_back({resolution, named.model(), why});
-  }
+  std::optional<double> edge;
+  if (run.problem.local_refinement) edge = run.problem.local_refinement->edge_m;
+  for (const auto& [name, why] : run.failed_variants)
+    failed.push_back({resolution, SweepPoint::model_name(name, volume, edge), why});
   std::vector<std::pair<std::size_t, massspring::IntegratorKind>> items;
   for (std::size_t v = 0; v < run.variants.size(); ++v)
     if (!volume || run.variants[v].parameters.contains("volume_preservation"))

@@ -26,13 +26,17 @@ namespace ms = msfem::massspring;
 // language offers runs on the fast kernels, the code a simulator would run.
 class TimedStepper {
  public:
-  TimedStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, const ms::State& start) {
+  TimedStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, const ms::State& start,
+               int threads) {
     if (kind == ms::IntegratorKind::implicit_euler) {
-      implicit_ = std::make_unique<ms::FastImplicitStepper>(model);
+      ms::FastImplicitOptions options;
+      if (threads > 0) options.threads = std::min(options.threads, threads);
+      implicit_ = std::make_unique<ms::FastImplicitStepper>(model, options);
       implicit_->set_state(start);
       return;
     }
     ms::FastStepperOptions options;
+    if (threads > 0) options.threads = std::min(options.threads, threads);
     options.integrator = kind == ms::IntegratorKind::central_difference
                              ? ms::IntegratorKind::symplectic_euler
                              : kind;
@@ -109,7 +113,7 @@ void settle(Timing& t, TimedStepper& stepper, const BuiltVariant& variant,
 }  // namespace
 
 Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
-                    const Eigen::VectorXd& equilibrium, bool measure_settling) {
+                    const Eigen::VectorXd& equilibrium, bool measure_settling, int threads) {
   const ms::MassSpringModel& model = *variant.model;
   const ms::IntegratorKind kind = timing.integrator;
   Timing t;
@@ -122,7 +126,7 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
   // diverge at half that step. Such a step bounds the timed code's stable step: halve and retry.
   for (int attempt = 0;; ++attempt) {
     try {
-      TimedStepper stepper(model, kind, start);
+      TimedStepper stepper(model, kind, start, threads);
       t.stepper = stepper.name();
       if (measure_settling) settle(t, stepper, variant, start.x, equilibrium);
       t.steps_per_second = median_rate(stepper, t.dt_s, timing.steps);

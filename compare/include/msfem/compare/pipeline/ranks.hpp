@@ -5,6 +5,7 @@
 // function here sees one rank.
 
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,15 @@ int index();
 inline bool is_root() {
   return index() == 0;
 }
+/// Ranks of the job on this rank's machine (sharing its cores): 1 when MPI is not running.
+int on_this_machine();
+
+/// Which of `ranks` ranks does each of a list of independent items, from each item's estimated
+/// cost: the costliest first, each to the rank with the least work so far (longest processing
+/// time first, within 4/3 of the best split; ties to the lower rank, so every rank deals alike).
+/// Round-robin would give one rank every costly item where the costs repeat with a period of the
+/// rank count.
+std::vector<int> deal(const std::vector<double>& cost, int ranks = count());
 
 /// Called first by `msfem`: starts MPI when a launcher (mpirun, srun) started the process with
 /// more than one rank in mind, and sends the standard output and error of every rank but 0 to
@@ -37,6 +47,9 @@ void agree(const std::function<void()>& work);
 
 /// Every rank's `bytes` on every rank, in rank order.
 std::vector<std::string> gather_on_all(const std::string& bytes);
+
+/// Every rank's `value` on every rank, in rank order (sent as CBOR).
+std::vector<nlohmann::json> gather_json_on_all(const nlohmann::json& value);
 
 /// Rank 0's `bytes` on every rank.
 std::string broadcast_from_root(const std::string& bytes);

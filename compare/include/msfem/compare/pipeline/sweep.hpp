@@ -35,7 +35,9 @@ struct SweepPoint {
   std::optional<double> contact_edge_m;
   /// The variant as the report names it: "variant", then "+volume" with volume preservation and
   /// "+refined@E mm" with contact refinement.
-  std::string model() const;
+  std::string model() const { return model_name(variant, volume_preservation, contact_edge_m); }
+  static std::string model_name(const std::string& variant, bool volume_preservation,
+                                std::optional<double> contact_edge_m);
   int resolution = 0;  ///< level or vertex target, as given
   int surface_vertices = 0;
   int nodes = 0, springs = 0;

@@ -104,8 +104,10 @@ struct Timing {
 };
 /// Times the case's integrator on the variant (with its loads), starting from rest, against the
 /// given static equilibrium (for the settle time).
-/// With measure_settling false the settle time is skipped (sweeps).
+/// With measure_settling false the settle time is skipped (sweeps). `threads` (> 0) caps the fast
+/// steppers' threads, for timings that run beside others on the same cores (0: their default).
 Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
-                    const Eigen::VectorXd& equilibrium, bool measure_settling = true);
+                    const Eigen::VectorXd& equilibrium, bool measure_settling = true,
+                    int threads = 0);
 
 }  // namespace msfem::compare
