@@ -5,6 +5,8 @@
 
 #include "msfem/compare/writers/plots.hpp"
 
+#include "msfem/compare/writers/plot_labels.hpp"
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -290,18 +292,6 @@ std::vector<ParetoPoint> pareto_front(std::vector<ParetoPoint> points) {
   return front;
 }
 
-// A data file column holding a label: double-quoted, so a double quote inside becomes a single one;
-// a line break would end the record, a tab would show as a gap.
-std::string label_column(const std::string& label) {
-  std::string out = label;
-  std::replace(out.begin(), out.end(), '"', '\'');
-  for (char& c : out)
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-  return "\"" + out + "\"";
-}
-
-}  // namespace
-
 // The distinct values of a field of the points, in first-seen order.
 template <typename Field>
 std::vector<std::string> groups_of(const std::vector<ParetoPoint>& points, Field field) {
@@ -311,6 +301,72 @@ std::vector<std::string> groups_of(const std::vector<ParetoPoint>& points, Field
       groups.push_back(p.*field);
   return groups;
 }
+
+// The plot area at fixed screen fractions, so that the labels' boxes (pixels) are known before
+// gnuplot draws: 900 x 600 pixels, the legend above the area.
+constexpr double kAreaLeft = 0.10, kAreaRight = 0.97, kAreaBottom = 0.10, kAreaTop = 0.76;
+const std::string kParetoMargins =
+    "set lmargin at screen 0.10\nset rmargin at screen 0.97\nset bmargin at screen 0.10\n"
+    "set tmargin at screen 0.76\n";
+
+double y_min(const std::vector<ParetoPoint>& points) {
+  double y = points.front().rel_error;
+  for (const ParetoPoint& p : points)
+    y = std::min(y, p.rel_error);
+  return y;
+}
+
+double y_max(const std::vector<ParetoPoint>& points) {
+  double y = points.front().rel_error;
+  for (const ParetoPoint& p : points)
+    y = std::max(y, p.rel_error);
+  return y;
+}
+
+// The log-log ranges shown: x from, x to, y from, y to.
+struct LogRanges {
+  double x0, x1, y0, y1;
+};
+
+// gnuplot labels for the front's points where place_labels found room (each with a leader line
+// where it had to move off its point's row); a label with no room is left out, its point stays.
+std::string front_labels(const std::vector<ParetoPoint>& front,
+                         const std::vector<ParetoPoint>& points, const LogRanges& r) {
+  LabelMetrics metrics;
+  metrics.area_width_px = (kAreaRight - kAreaLeft) * 900.0;
+  metrics.area_height_px = (kAreaTop - kAreaBottom) * 600.0;
+  const auto fraction = [](double v, double from, double to) {
+    return std::log(v / from) / std::log(to / from);
+  };
+  const auto pixels = [&](const ParetoPoint& p) {
+    return std::make_pair(fraction(p.realtime_factor, r.x0, r.x1) * metrics.area_width_px,
+                          fraction(p.rel_error, r.y0, r.y1) * metrics.area_height_px);
+  };
+  std::vector<std::pair<double, double>> at, others;
+  std::vector<std::string> texts;
+  for (const ParetoPoint& p : front) {
+    at.push_back(pixels(p));
+    texts.push_back(p.label);
+  }
+  for (const ParetoPoint& p : points)
+    others.push_back(pixels(p));
+  std::ostringstream out;
+  const std::vector<PlacedLabel> placed = place_labels(at, texts, metrics, others);
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    const PlacedLabel& l = placed[i];
+    if (!l.placed) continue;
+    const double gx = l.x_px / metrics.area_width_px, gy = l.y_px / metrics.area_height_px;
+    out << "set label " << quoted(texts[i]) << " at graph " << number(gx) << ", " << number(gy)
+        << (l.right_of_point ? " left" : " right") << " font ',9' front\n";
+    if (l.displaced)
+      out << "set arrow from first " << number(front[i].realtime_factor) << ", first "
+          << number(front[i].rel_error) << " to graph " << number(gx) << ", " << number(gy)
+          << " nohead lw 0.5 lc 'gray50'\n";
+  }
+  return out.str();
+}
+
+}  // namespace
 
 fs::path pareto(const fs::path& path, const std::string& title,
                 const std::vector<ParetoPoint>& points) {
@@ -334,14 +390,19 @@ fs::path pareto(const fs::path& path, const std::string& title,
     }
     data << "\n\n";
   }
-  for (const ParetoPoint& p : pareto_front(points))
-    data << number(p.realtime_factor) << ' ' << number(p.rel_error) << ' ' << label_column(p.label)
-         << '\n';
+  const std::vector<ParetoPoint> front_points = pareto_front(points);
+  for (const ParetoPoint& p : front_points)
+    data << number(p.realtime_factor) << ' ' << number(p.rel_error) << '\n';
   const std::size_t front = colours.size();
+  const double y_low = std::pow(10.0, std::floor(std::log10(y_min(points))));
+  const double y_high = std::max(std::pow(10.0, std::ceil(std::log10(y_max(points)))), 10 * y_low);
   std::ostringstream commands;
   commands << labels(title, "real-time factor (simulated s per wall s)", "relative error")
            << "set logscale xy\nset key outside right top\n"
            << "set xrange [" << number(x_low / 2) << ":" << number(x_high * 4) << "]\n"
+           << "set yrange [" << number(y_low) << ":" << number(y_high) << "]\n"
+           << kParetoMargins
+           << front_labels(front_points, points, {x_low / 2, x_high * 4, y_low, y_high})
            << "set arrow from 1, graph 0 to 1, graph 1 nohead dt 2 lw 1.5 lc 'gray30'\n"
            << "set label 'real time' at 1, graph 0.96 offset char 0.5,0 left tc 'gray30'\n"
            << "plot data index " << front
@@ -359,8 +420,7 @@ fs::path pareto(const fs::path& path, const std::string& title,
       commands << ", \\\n     data index " << c
                << " using 1:($4 > 0 ? $2 : NaN) with points pt 6 ps 2.6 lw 1.5 lc 'black' "
                << (c == 0 ? "title '1 kHz in real time'" : "notitle");
-  commands << ", \\\n     data index " << front
-           << " using 1:2:3 with labels offset char 0.8,0.6 left font ',9' notitle\n";
+  commands << "\n";
   return render(path, data.str(), commands.str());
 }
 
