@@ -1,8 +1,8 @@
 // The spring variants of a run shared across MPI ranks. The unit of work is one variant at one
 // load (its statics along the loading path), dealt by estimated cost (ranks::deal): the three
 // tiers have three times the nodes of one surface, and at one load (a sweep's resolution) dealing
-// round-robin gave the three tiers and the skeleton to one rank and the single layer alone to the
-// other. Each rank builds a variant once for its loads. The timing
+// round-robin would give the three tiers and the skeleton to one rank and the single layer alone
+// to the other. Each rank builds a variant once for its loads. The timing
 // (steps per second) runs afterwards on one rank at a time, the others asleep in a barrier, so
 // that no rank competes for the timed rank's core.
 #include <algorithm>
