@@ -305,22 +305,10 @@ std::vector<std::string> groups_of(const std::vector<ParetoPoint>& points, Field
 // The plot area at fixed screen fractions, so that the labels' boxes (pixels) are known before
 // gnuplot draws: 900 x 600 pixels, the legend above the area.
 constexpr double kAreaLeft = 0.10, kAreaRight = 0.97, kAreaBottom = 0.10, kAreaTop = 0.76;
-const std::string kParetoMargins =
-    "set lmargin at screen 0.10\nset rmargin at screen 0.97\nset bmargin at screen 0.10\n"
-    "set tmargin at screen 0.76\n";
-
-double y_min(const std::vector<ParetoPoint>& points) {
-  double y = points.front().rel_error;
-  for (const ParetoPoint& p : points)
-    y = std::min(y, p.rel_error);
-  return y;
-}
-
-double y_max(const std::vector<ParetoPoint>& points) {
-  double y = points.front().rel_error;
-  for (const ParetoPoint& p : points)
-    y = std::max(y, p.rel_error);
-  return y;
+std::string pareto_margins() {
+  return "set lmargin at screen " + number(kAreaLeft) + "\nset rmargin at screen " +
+         number(kAreaRight) + "\nset bmargin at screen " + number(kAreaBottom) +
+         "\nset tmargin at screen " + number(kAreaTop) + "\n";
 }
 
 // The log-log ranges shown: x from, x to, y from, y to.
@@ -394,14 +382,18 @@ fs::path pareto(const fs::path& path, const std::string& title,
   for (const ParetoPoint& p : front_points)
     data << number(p.realtime_factor) << ' ' << number(p.rel_error) << '\n';
   const std::size_t front = colours.size();
-  const double y_low = std::pow(10.0, std::floor(std::log10(y_min(points))));
-  const double y_high = std::max(std::pow(10.0, std::ceil(std::log10(y_max(points)))), 10 * y_low);
+  const auto [lowest, highest] = std::minmax_element(
+      points.begin(), points.end(),
+      [](const ParetoPoint& a, const ParetoPoint& b) { return a.rel_error < b.rel_error; });
+  const double y_low = std::pow(10.0, std::floor(std::log10(lowest->rel_error)));
+  const double y_high =
+      std::max(std::pow(10.0, std::ceil(std::log10(highest->rel_error))), 10 * y_low);
   std::ostringstream commands;
   commands << labels(title, "real-time factor (simulated s per wall s)", "relative error")
            << "set logscale xy\nset key outside right top\n"
            << "set xrange [" << number(x_low / 2) << ":" << number(x_high * 4) << "]\n"
            << "set yrange [" << number(y_low) << ":" << number(y_high) << "]\n"
-           << kParetoMargins
+           << pareto_margins()
            << front_labels(front_points, points, {x_low / 2, x_high * 4, y_low, y_high})
            << "set arrow from 1, graph 0 to 1, graph 1 nohead dt 2 lw 1.5 lc 'gray30'\n"
            << "set label 'real time' at 1, graph 0.96 offset char 0.5,0 left tc 'gray30'\n"
