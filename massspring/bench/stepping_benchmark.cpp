@@ -179,6 +179,9 @@ PrecisionComparison compare_precision(const MassSpringModel& model, double dt, i
   exact.set_state(start);
   single.set_state(start);
   PrecisionComparison c;
+  for (int i = 0; i < model.num_nodes(); ++i)
+    c.max_displacement_m =
+        std::max(c.max_displacement_m, (start.x - rest).segment<3>(3 * i).norm());
   for (c.steps = 0; c.steps < steps;) {
     const int n = std::min(100, steps - c.steps);
     exact.step(dt, n);

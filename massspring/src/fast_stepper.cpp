@@ -7,6 +7,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <sstream>
+#include <type_traits>
 
 #include "adaptive_threads.hpp"
 #include "gather_kernels.hpp"
@@ -43,7 +44,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
       : model_(&model),
         team_(std::max(options.threads, 1)),
         threads_(team_.size(), options.adaptive_threads),
-        soa_(model, options.reorder_nodes),
+        soa_(model, options.reorder_nodes, std::is_same_v<Real, float>),
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))},
@@ -73,7 +74,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     State out{Eigen::VectorXd(3 * soa_.num_nodes), Eigen::VectorXd(3 * soa_.num_nodes), time_};
     for (int i = 0; i < soa_.num_nodes; ++i)
       for (int c = 0; c < 3; ++c) {
-        out.x[3 * soa_.order[i] + c] = r[kRecord * i + c];
+        out.x[3 * soa_.order[i] + c] = soa_.frame_at(c, i) + r[kRecord * i + c];
         out.v[3 * soa_.order[i] + c] = r[kRecord * i + 3 + c];
       }
     return out;
@@ -184,8 +185,11 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     const std::size_t per_slot =
         sizeof(int) +
         (gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) * sizeof(Real);
-    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real)) + slots * per_slot +
-                             gather_.chunk_slot.size() * sizeof(int);
+    // A relative layout reads each lane's frame position too (its neighbours' are gathered from
+    // cache, as their records are).
+    const std::size_t own_frame = gather_.frame.empty() ? 0 : detail::kDirection * sizeof(Real);
+    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real) + own_frame) +
+                             slots * per_slot + gather_.chunk_slot.size() * sizeof(int);
     const std::size_t buffer = records_[0].size() * sizeof(Real);
     // RK4's record buffers: the first stage reads `in` and writes out and acc (3), the middle two
     // read in, base and acc and write out and acc (5 each), the last reads in and acc and writes
@@ -244,7 +248,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
       const int node = field_nodes_[k];
       const int i = soa_.new_id[static_cast<std::size_t>(node)];
       for (int c = 0; c < 3; ++c) {
-        field_x_[3 * node + c] = before[kRecord * i + c];
+        field_x_[3 * node + c] = soa_.frame_at(c, i) + before[kRecord * i + c];
         field_v_[3 * node + c] = before[kRecord * i + 3 + c];
       }
     }

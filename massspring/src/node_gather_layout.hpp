@@ -87,6 +87,9 @@ struct NodeGatherLayout {
   Real uniform_c = 0;  // every spring's c when spring_damping == uniform
   AlignedVector<Real> mass, inverse_mass, damping, anchor, load[3];  // per lane (idle: mass 1)
   std::vector<int> block_begin;  // chunk ranges handed out to the threads
+  // Relative records (soa_layout.hpp): each node's frame position, kDirection reals per record
+  // (the idle and far records at the origin), gathered beside the records; empty otherwise.
+  AlignedVector<Real> frame;
 
   explicit NodeGatherLayout(const SoaLayout<Real>& soa) {
     idle_record = soa.num_nodes;
@@ -136,6 +139,12 @@ struct NodeGatherLayout {
       l.assign(lane_node.size(), Real(0));
     load_parameters(soa);
     partition();
+    if (soa.relative) {
+      frame.assign(static_cast<std::size_t>(kDirection) * (soa.num_nodes + 2), Real(0));
+      for (int i = 0; i < soa.num_nodes; ++i)
+        for (int d = 0; d < 3; ++d)
+          frame[kDirection * i + d] = static_cast<Real>(soa.frame_at(d, i));
+    }
   }
 
   static int record_offset(int node) { return node * kRecord * static_cast<int>(sizeof(Real)); }

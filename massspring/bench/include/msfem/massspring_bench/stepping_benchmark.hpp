@@ -60,7 +60,8 @@ struct RateSpread {
 
 /// The single-precision explicit stepper against the double one on the same loaded run (both from
 /// loaded_start, the same dt): the largest distance between a node's two positions at any of the
-/// checkpoints, and the largest displacement from rest the double run reached there.
+/// checkpoints, and the largest displacement from rest of the run, its loaded start included (a
+/// damped model rings down within the first checkpoints; its error is the memory of that start).
 struct PrecisionComparison {
   int steps = 0;
   double max_node_error_m = 0.0;
