@@ -8,6 +8,37 @@ std::shared_ptr<const ForceField> ForceField::scaled(const std::string& group, d
   throw ModelError("force field: no coefficient group '" + group + "' to scale");
 }
 
+namespace {
+
+class RecomputedTangent final : public ForceField::Tangent {
+ public:
+  RecomputedTangent(const ForceField& field, const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                    Linearisation mode)
+      : field_(&field), x_(&x), v_(&v), mode_(mode) {}
+  void set_part(int, int) override {}
+  void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
+                        int parts) const override {
+    field_->add_dfdx_product_part(*x_, *v_, dx, df, mode_, part, parts);
+  }
+  void add_diagonal_blocks_part(double cx, double cv, std::vector<Eigen::Matrix3d>& blocks,
+                                int part, int) const override {
+    if (part == 0) field_->add_diagonal_blocks(*x_, *v_, cx, cv, blocks, mode_);
+  }
+
+ private:
+  const ForceField* field_;
+  const Eigen::VectorXd *x_, *v_;
+  Linearisation mode_;
+};
+
+}  // namespace
+
+std::unique_ptr<ForceField::Tangent> ForceField::tangent(const Eigen::VectorXd& x,
+                                                         const Eigen::VectorXd& v,
+                                                         Linearisation mode) const {
+  return std::make_unique<RecomputedTangent>(*this, x, v, mode);
+}
+
 void ForceField::add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd& v, double cx,
                                      double cv, std::vector<Eigen::Matrix3d>& blocks,
                                      Linearisation mode) const {

@@ -29,9 +29,11 @@ class ImplicitFields {
   // The model's fields and, per field node, its new id, lane and block (-1 when constrained).
   void take(const MassSpringModel& model) {
     fields_.clear();
+    tangents_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
     for (const auto& field : model.fields()) {
       fields_.push_back(field.field);
+      tangents_.push_back(field.field->tangent(x_, v_, Linearisation::definite));
       for (int node : field.field->nodes())
         used[static_cast<std::size_t>(node)] = 1;
     }
@@ -59,8 +61,10 @@ class ImplicitFields {
       *v = zero;
     for (auto* per_member : {&b_part_, &a_part_, &product_part_})
       per_member->assign(static_cast<std::size_t>(team_), zero);
-    blocks_.assign(fields_.empty() ? 0 : static_cast<std::size_t>(soa_->num_nodes),
-                   Eigen::Matrix3d::Zero());
+    blocks_part_.assign(static_cast<std::size_t>(team_),
+                        std::vector<Eigen::Matrix3d>(
+                            fields_.empty() ? 0 : static_cast<std::size_t>(soa_->num_nodes),
+                            Eigen::Matrix3d::Zero()));
     member_dots_.assign(static_cast<std::size_t>(team_), 0.0);
   }
 
@@ -80,24 +84,24 @@ class ImplicitFields {
   }
 
   // After the pass's barrier, this member's part of the fields' right-hand side, b_F / h =
-  // f_F + K_F (h v), and of -A_F Δv / h = K_F (h Δv) + D_F Δv; member 0 also the diagonal blocks
-  // of -A_F = h D_F + h² K_F.
+  // f_F + K_F (h v), of -A_F Δv / h = K_F (h Δv) + D_F Δv and of the diagonal blocks of
+  // -A_F = h D_F + h² K_F.
   void start_part(int member, int members, double h) {
     Eigen::VectorXd& b = b_part_[static_cast<std::size_t>(member)];
     Eigen::VectorXd& a = a_part_[static_cast<std::size_t>(member)];
+    std::vector<Eigen::Matrix3d>& blocks = blocks_part_[static_cast<std::size_t>(member)];
     zero_at_nodes(b);
     zero_at_nodes(a);
-    for (const auto& field : fields_) {
-      field->add_force_part(x_, v_, b, member, members);
-      field->add_dfdx_product_part(x_, v_, hv_, b, Linearisation::definite, member, members);
-      field->add_dfdx_product_part(x_, v_, hdv_, a, Linearisation::definite, member, members);
-      if (member == 0) field->add_dfdv_product(x_, dv_, a);
-    }
-    if (member != 0) return;
     for (const Node& n : nodes_)
-      blocks_[static_cast<std::size_t>(n.node)].setZero();
-    for (const auto& field : fields_)
-      field->add_diagonal_blocks(x_, v_, h * h, h, blocks_, Linearisation::definite);
+      blocks[static_cast<std::size_t>(n.node)].setZero();
+    for (std::size_t k = 0; k < fields_.size(); ++k) {
+      fields_[k]->add_force_part(x_, v_, b, member, members);
+      tangents_[k]->set_part(member, members);
+      tangents_[k]->add_product_part(hv_, b, member, members);
+      tangents_[k]->add_product_part(hdv_, a, member, members);
+      if (member == 0) fields_[k]->add_dfdv_product(x_, dv_, a);
+      tangents_[k]->add_diagonal_blocks_part(h * h, h, blocks, member, members);
+    }
   }
 
   // After the next barrier, at this member's field lanes: b += b_F, r += b_F - A_F Δv, the
@@ -107,9 +111,11 @@ class ImplicitFields {
     for (const Node& n : nodes_) {
       if (n.lane < 0 || !owns(n, b0, b1)) continue;
       Eigen::Vector3d b_field = Eigen::Vector3d::Zero(), a_field = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d field_block = Eigen::Matrix3d::Zero();
       for (int m = 0; m < members; ++m) {
         b_field += b_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
         a_field += a_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
+        field_block += blocks_part_[static_cast<std::size_t>(m)][static_cast<std::size_t>(n.node)];
       }
       Eigen::Vector3d r;
       for (int c = 0; c < 3; ++c) {
@@ -117,8 +123,7 @@ class ImplicitFields {
         cg.r[c][n.lane] += static_cast<Real>(h * (b_field[c] + a_field[c]));
         r[c] = cg.r[c][n.lane];
       }
-      const Eigen::Matrix3d block =
-          read_block(cg, n.lane).inverse() - blocks_[static_cast<std::size_t>(n.node)];
+      const Eigen::Matrix3d block = read_block(cg, n.lane).inverse() - field_block;
       const Eigen::Matrix3d inverse = block.inverse();
       write_block(cg, n.lane, inverse);
       const Eigen::Vector3d u = inverse * r;
@@ -146,9 +151,9 @@ class ImplicitFields {
   void product_part(int member, int members) {
     Eigen::VectorXd& y = product_part_[static_cast<std::size_t>(member)];
     zero_at_nodes(y);
-    for (const auto& field : fields_) {
-      field->add_dfdx_product_part(x_, v_, hu_, y, Linearisation::definite, member, members);
-      if (member == 0) field->add_dfdv_product(x_, u_, y);
+    for (std::size_t k = 0; k < fields_.size(); ++k) {
+      tangents_[k]->add_product_part(hu_, y, member, members);
+      if (member == 0) fields_[k]->add_dfdv_product(x_, u_, y);
     }
     double dot = 0.0;
     for (const Node& n : nodes_)
@@ -202,10 +207,12 @@ class ImplicitFields {
   const NodeGatherLayout<Real, W>* gather_;
   int team_;
   std::vector<std::shared_ptr<const ForceField>> fields_;
+  std::vector<std::unique_ptr<ForceField::Tangent>> tangents_;  // one per field, set each step
   std::vector<Node> nodes_;
   Eigen::VectorXd x_, v_, hv_, dv_, hdv_, hu_, u_;  // shared, written at field nodes by owners
   std::vector<Eigen::VectorXd> b_part_, a_part_, product_part_;  // per member
-  std::vector<Eigen::Matrix3d> blocks_;                          // per node: h D_F + h² K_F
+  // per member, per node: its part of h D_F + h² K_F
+  std::vector<std::vector<Eigen::Matrix3d>> blocks_part_;
   std::vector<double> member_dots_;
 };
 

@@ -253,6 +253,66 @@ void VolumeForceField::add_dfdx_product_part(const Eigen::VectorXd& x, const Eig
   }
 }
 
+// −(κ/|V⁰|) (∂V·dx) ∂V with each element's g = −6 ∂V, taken at set_part and kept: per element
+// node its g scaled by √(κ/|V⁰|)/6, so that a product is Σ ĝ·dx and df −= (Σ ĝ·dx) ĝ.
+class DefiniteVolumeTangent final : public ForceField::Tangent {
+ public:
+  DefiniteVolumeTangent(const VolumeForceField& field, const Eigen::VectorXd& x)
+      : field_(&field), x_(&x), g_(field.element_node_offset_.size()) {}
+
+  void set_part(int part, int parts) override {
+    const auto& f = *field_;
+    Vec3 g[VolumeForceField::kMaxElementNodes];
+    const auto [first, last] = f.element_range(part, parts);
+    for (int e = first; e < last; ++e) {
+      const double root =
+          std::sqrt(f.elements_.modulus[e] / std::abs(f.elements_.rest_volume[e])) / 6.0;
+      f.element_gradient(e, x_->data(), g);
+      for (int k = f.element_node_start_[e]; k < f.element_node_start_[e + 1]; ++k)
+        g_[static_cast<std::size_t>(k)] = root * g[k - f.element_node_start_[e]];
+    }
+  }
+
+  void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
+                        int parts) const override {
+    const auto& f = *field_;
+    const auto [first, last] = f.element_range(part, parts);
+    const int* offset = f.element_node_offset_.data();
+    for (int e = first; e < last; ++e) {
+      const int begin = f.element_node_start_[e], end = f.element_node_start_[e + 1];
+      double g_dx = 0.0;
+      for (int k = begin; k < end; ++k)
+        g_dx += g_[static_cast<std::size_t>(k)].dot(Vec3::Map(dx.data() + offset[k]));
+      for (int k = begin; k < end; ++k)
+        Vec3::Map(df.data() + offset[k]) -= g_dx * g_[static_cast<std::size_t>(k)];
+    }
+  }
+
+  // The field has no velocity term: cv does not enter.
+  void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
+                                int parts) const override {
+    const auto& f = *field_;
+    const auto [first, last] = f.element_range(part, parts);
+    const int* offset = f.element_node_offset_.data();
+    for (int k = f.element_node_start_[first]; k < f.element_node_start_[last]; ++k) {
+      const Vec3& g = g_[static_cast<std::size_t>(k)];
+      blocks[static_cast<std::size_t>(offset[k] / 3)] -= cx * g * g.transpose();
+    }
+  }
+
+ private:
+  const VolumeForceField* field_;
+  const Eigen::VectorXd* x_;
+  std::vector<Vec3> g_;  // per element node, as element_node_offset_
+};
+
+std::unique_ptr<ForceField::Tangent> VolumeForceField::tangent(const Eigen::VectorXd& x,
+                                                               const Eigen::VectorXd& v,
+                                                               Linearisation mode) const {
+  if (mode == Linearisation::exact) return ForceField::tangent(x, v, mode);
+  return std::make_unique<DefiniteVolumeTangent>(*this, x);
+}
+
 // The blocks of −(κ/|V⁰|) ∂V ∂Vᵀ: the exact Jacobian's diagonal blocks are these too, as an
 // element's volume is linear in each of its nodes.
 void VolumeForceField::add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd&,

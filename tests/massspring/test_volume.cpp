@@ -54,6 +54,47 @@ TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
   EXPECT_LE(moment.norm(), 1e-12 * f.norm() * 0.05);
 }
 
+// The kept tangent (each element's gradient stored once) multiplies, and gives the diagonal
+// blocks, as the definite calls that recompute the gradients, in one part and shared by three, and
+// follows the state it was made with when set again.
+TEST(VolumeForceField, KeptTangentMultipliesAsTheRecomputedProduct) {
+  const SpringNetwork network = three_tier_sphere(1);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  const VolumeForceField volume(
+      network.num_nodes(),
+      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 8000.0));
+  Eigen::VectorXd x = perturbed(flatten(network.rest_positions), 0.004, 3);
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  const Eigen::VectorXd dx = perturbed(Eigen::VectorXd::Zero(x.size()), 0.001, 5);
+  const auto tangent = volume.tangent(x, v, Linearisation::definite);
+  for (int round = 0; round < 2; ++round) {
+    Eigen::VectorXd expected = Eigen::VectorXd::Zero(x.size());
+    volume.add_dfdx_product(x, v, dx, expected, Linearisation::definite);
+    ASSERT_GT(expected.norm(), 0.0);
+    for (const int parts : {1, 3}) {
+      Eigen::VectorXd product = Eigen::VectorXd::Zero(x.size());
+      for (int part = 0; part < parts; ++part) {
+        tangent->set_part(part, parts);
+        tangent->add_product_part(dx, product, part, parts);
+      }
+      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << parts << " " << round;
+      std::vector<Eigen::Matrix3d> blocks(network.num_nodes(), Eigen::Matrix3d::Zero()),
+          recomputed = blocks;
+      for (int part = 0; part < parts; ++part)
+        tangent->add_diagonal_blocks_part(2.0, 3.0, blocks, part, parts);
+      volume.add_diagonal_blocks(x, v, 2.0, 3.0, recomputed, Linearisation::definite);
+      double worst = 0.0, largest = 0.0;
+      for (int i = 0; i < network.num_nodes(); ++i) {
+        worst = std::max(worst, (blocks[i] - recomputed[i]).norm());
+        largest = std::max(largest, recomputed[i].norm());
+      }
+      ASSERT_GT(largest, 0.0);
+      EXPECT_LE(worst, 1e-12 * largest) << parts << " " << round;
+    }
+    x = perturbed(x, 0.002, 7);  // the next round's state, read through the same tangent
+  }
+}
+
 TEST(VolumeForceField, PrismsRespondAlikeWhicheverCornerTheirTrianglesStartAt) {
   // Rotating each triangle's vertex order must not change the element's volume away from rest
   // (one 3-tetrahedron split alone does: its diagonals depend on the order).

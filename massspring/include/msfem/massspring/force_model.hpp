@@ -98,6 +98,30 @@ class ForceField : public ForceModel {
   virtual void add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd& v, double cx,
                                    double cv, std::vector<Eigen::Matrix3d>& blocks,
                                    Linearisation mode) const;
+
+  /// ∂f/∂x at the state held in x and v, kept for many products: the fast implicit stepper's CG
+  /// multiplies with the same tangent a score of times per step. Set and multiplied in parts, as
+  /// add_dfdx_product_part is; a part's products read only what the same part set, so a thread
+  /// that has set its part may multiply at once.
+  class Tangent {
+   public:
+    virtual ~Tangent() = default;
+    /// Part `part` of `parts` of the tangent at the x and v it was made with, as they are now.
+    virtual void set_part(int part, int parts) = 0;
+    /// Part `part` of `parts` of df += (∂f/∂x) dx, with the parts of set_part.
+    virtual void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
+                                  int parts) const = 0;
+    /// Part `part` of `parts` of add_diagonal_blocks(x, v, cx, cv, blocks, mode): threads that
+    /// each add a part into their own `blocks` together add the whole.
+    virtual void add_diagonal_blocks_part(double cx, double cv,
+                                          std::vector<Eigen::Matrix3d>& blocks, int part,
+                                          int parts) const = 0;
+  };
+  /// A tangent at the state in x and v, which must outlive it. By default it multiplies with
+  /// add_dfdx_product_part at each product, which suits a field whose product costs little beside
+  /// its state (a tool's contact).
+  virtual std::unique_ptr<Tangent> tangent(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                           Linearisation mode) const;
 };
 
 }  // namespace msfem::massspring
