@@ -29,12 +29,17 @@ SpringNetwork three_tier_sphere(int level) {
   return build_three_tier(mesh.vertices, mesh.triangles, ThreeTierOptions{});
 }
 
+// Volume preservation on the shell prisms of a three-tier network.
+VolumeForceField shell_prisms(const SpringNetwork& network, double modulus) {
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  return VolumeForceField(
+      network.num_nodes(),
+      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, modulus));
+}
+
 TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
   const SpringNetwork network = three_tier_sphere(1);
-  const int nv = static_cast<int>(network.surface_nodes.size());
-  const VolumeForceField volume(
-      network.num_nodes(),
-      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 8000.0));
+  const VolumeForceField volume = shell_prisms(network, 8000.0);
   // Perturbed by a fifth of the 2.5 cm shell: every element away from its rest volume.
   const Eigen::VectorXd x = perturbed(flatten(network.rest_positions), 0.004, 3);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
@@ -59,10 +64,7 @@ TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
 // follows the state it was made with when set again.
 TEST(VolumeForceField, KeptTangentMultipliesAsTheRecomputedProduct) {
   const SpringNetwork network = three_tier_sphere(1);
-  const int nv = static_cast<int>(network.surface_nodes.size());
-  const VolumeForceField volume(
-      network.num_nodes(),
-      tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, 8000.0));
+  const VolumeForceField volume = shell_prisms(network, 8000.0);
   Eigen::VectorXd x = perturbed(flatten(network.rest_positions), 0.004, 3);
   const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
   const Eigen::VectorXd dx = perturbed(Eigen::VectorXd::Zero(x.size()), 0.001, 5);
