@@ -22,6 +22,25 @@ Mat3 cross_matrix(const Vec3& v) {
   return m;
 }
 
+// The definite Jacobian −(κ/|V⁰|) ∂V ∂Vᵀ of one element, with its g = −6 ∂V at its nodes (offsets
+// 3·id into the full vectors), `scale` = κ/|V⁰|: df −= scale/36 (g·dx) g ...
+void add_element_product(const Vec3* g, const int* offset, int nodes, double scale,
+                         const double* dx, double* df) {
+  double g_dx = 0.0;
+  for (int k = 0; k < nodes; ++k)
+    g_dx += g[k].dot(Vec3::Map(dx + offset[k]));
+  for (int k = 0; k < nodes; ++k)
+    Vec3::Map(df + offset[k]) -= (scale * g_dx / 36.0) * g[k];
+}
+
+// ... and its diagonal blocks, times cx: blocks[i] −= cx scale/36 g_i g_iᵀ.
+void add_element_blocks(const Vec3* g, const int* offset, int nodes, double cx, double scale,
+                        std::vector<Mat3>& blocks) {
+  for (int k = 0; k < nodes; ++k)
+    blocks[static_cast<std::size_t>(offset[k] / 3)] -=
+        (cx * scale / 36.0) * g[k] * g[k].transpose();
+}
+
 // One tetrahedron at x: its four node ids, V = (1/6) e1 · (e2 × e3) with e_i = x_i − x_0, and
 // ∂V/∂x_i.
 struct Tet {
@@ -224,8 +243,6 @@ double VolumeForceField::potential_energy(const Eigen::VectorXd& x) const {
 
 // ∂f/∂x = −(κ/|V⁰|) (g gᵀ + (V − V⁰) ∂²V): the first term is negative semi-definite and is all
 // the definite linearisation keeps.
-// ∂f/∂x = −(κ/|V⁰|) (g gᵀ + (V − V⁰) ∂²V): the first term is negative semi-definite and is all
-// the definite linearisation keeps.
 void VolumeForceField::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                         const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                                         Linearisation mode) const {
@@ -243,67 +260,65 @@ void VolumeForceField::add_dfdx_product_part(const Eigen::VectorXd& x, const Eig
     const double scale = elements_.modulus[e] / std::abs(elements_.rest_volume[e]);
     if (scale == 0.0) continue;
     element_gradient(e, x.data(), g);
-    const int* offset = element_node_offset_.data() + element_node_start_[e];
-    const int nodes = element_node_start_[e + 1] - element_node_start_[e];
-    double g_dx = 0.0;
-    for (int k = 0; k < nodes; ++k)
-      g_dx += g[k].dot(Vec3::Map(dx.data() + offset[k]));
-    for (int k = 0; k < nodes; ++k)
-      Vec3::Map(df.data() + offset[k]) -= (scale * g_dx / 36.0) * g[k];
+    add_element_product(g, element_node_offset_.data() + element_node_start_[e],
+                        element_node_start_[e + 1] - element_node_start_[e], scale, dx.data(),
+                        df.data());
   }
 }
 
-// −(κ/|V⁰|) (∂V·dx) ∂V with each element's g = −6 ∂V, taken at set_part and kept: per element
-// node its g scaled by √(κ/|V⁰|)/6, so that a product is Σ ĝ·dx and df −= (Σ ĝ·dx) ĝ.
+// The definite Jacobian with each element's g = −6 ∂V taken at set_part and kept, so that a
+// product is the element's gather and scatter alone.
 class DefiniteVolumeTangent final : public ForceField::Tangent {
  public:
   DefiniteVolumeTangent(const VolumeForceField& field, const Eigen::VectorXd& x)
-      : field_(&field), x_(&x), g_(field.element_node_offset_.size()) {}
+      : field_(&field),
+        x_(&x),
+        g_(field.element_node_offset_.size()),
+        scale_(static_cast<std::size_t>(field.elements_.num_elements()), 0.0) {}
 
   void set_part(int part, int parts) override {
     const auto& f = *field_;
-    Vec3 g[VolumeForceField::kMaxElementNodes];
     const auto [first, last] = f.element_range(part, parts);
     for (int e = first; e < last; ++e) {
-      const double root =
-          std::sqrt(f.elements_.modulus[e] / std::abs(f.elements_.rest_volume[e])) / 6.0;
+      scale_[static_cast<std::size_t>(e)] =
+          f.elements_.modulus[e] / std::abs(f.elements_.rest_volume[e]);
+      Vec3 g[VolumeForceField::kMaxElementNodes];
       f.element_gradient(e, x_->data(), g);
-      for (int k = f.element_node_start_[e]; k < f.element_node_start_[e + 1]; ++k)
-        g_[static_cast<std::size_t>(k)] = root * g[k - f.element_node_start_[e]];
+      std::copy(g, g + nodes(e), g_.begin() + f.element_node_start_[e]);
     }
   }
 
   void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
                         int parts) const override {
-    const auto& f = *field_;
-    const auto [first, last] = f.element_range(part, parts);
-    const int* offset = f.element_node_offset_.data();
-    for (int e = first; e < last; ++e) {
-      const int begin = f.element_node_start_[e], end = f.element_node_start_[e + 1];
-      double g_dx = 0.0;
-      for (int k = begin; k < end; ++k)
-        g_dx += g_[static_cast<std::size_t>(k)].dot(Vec3::Map(dx.data() + offset[k]));
-      for (int k = begin; k < end; ++k)
-        Vec3::Map(df.data() + offset[k]) -= g_dx * g_[static_cast<std::size_t>(k)];
-    }
+    const auto [first, last] = field_->element_range(part, parts);
+    for (int e = first; e < last; ++e)
+      if (scale_[static_cast<std::size_t>(e)] != 0.0)
+        add_element_product(gradient(e), offsets(e), nodes(e), scale_[static_cast<std::size_t>(e)],
+                            dx.data(), df.data());
   }
 
   // The field has no velocity term: cv does not enter.
   void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
                                 int parts) const override {
-    const auto& f = *field_;
-    const auto [first, last] = f.element_range(part, parts);
-    const int* offset = f.element_node_offset_.data();
-    for (int k = f.element_node_start_[first]; k < f.element_node_start_[last]; ++k) {
-      const Vec3& g = g_[static_cast<std::size_t>(k)];
-      blocks[static_cast<std::size_t>(offset[k] / 3)] -= cx * g * g.transpose();
-    }
+    const auto [first, last] = field_->element_range(part, parts);
+    for (int e = first; e < last; ++e)
+      add_element_blocks(gradient(e), offsets(e), nodes(e), cx, scale_[static_cast<std::size_t>(e)],
+                         blocks);
   }
 
  private:
+  int nodes(int e) const {
+    return field_->element_node_start_[e + 1] - field_->element_node_start_[e];
+  }
+  const int* offsets(int e) const {
+    return field_->element_node_offset_.data() + field_->element_node_start_[e];
+  }
+  const Vec3* gradient(int e) const { return g_.data() + field_->element_node_start_[e]; }
+
   const VolumeForceField* field_;
   const Eigen::VectorXd* x_;
-  std::vector<Vec3> g_;  // per element node, as element_node_offset_
+  std::vector<Vec3> g_;        // per element node, as element_node_offset_
+  std::vector<double> scale_;  // per element, κ/|V⁰|
 };
 
 std::unique_ptr<ForceField::Tangent> VolumeForceField::tangent(const Eigen::VectorXd& x,
@@ -323,11 +338,8 @@ void VolumeForceField::add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen
     const double scale = elements_.modulus[e] / std::abs(elements_.rest_volume[e]);
     if (scale == 0.0) continue;
     element_gradient(e, x.data(), g);
-    const int* offset = element_node_offset_.data() + element_node_start_[e];
-    const int nodes = element_node_start_[e + 1] - element_node_start_[e];
-    for (int k = 0; k < nodes; ++k)
-      blocks[static_cast<std::size_t>(offset[k] / 3)] -=
-          (cx * scale / 36.0) * g[k] * g[k].transpose();
+    add_element_blocks(g, element_node_offset_.data() + element_node_start_[e],
+                       element_node_start_[e + 1] - element_node_start_[e], cx, scale, blocks);
   }
 }
 
