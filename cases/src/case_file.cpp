@@ -13,6 +13,7 @@
 #include <regex>
 #include <sstream>
 
+#include "case_consistency.hpp"
 #include "case_file_text.hpp"
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
@@ -209,11 +210,12 @@ void declare_fem_timing_output(ParameterHandler& prm) {
       "error estimate", "auto", Patterns::Selection(selection_of<FemParameters::ErrorEstimate>()),
       "The reference's own discretisation error, from a second solve of each tool load: refine "
       "(the same degree on the mesh with every tetrahedron split into eight), degree (degree 2 "
-      "on the same mesh; needs degree = 1), none. auto: degree at degree 1; refine at degree 2 "
-      "for every load if that costs at most 3x the reference's own solves (or the refined "
-      "problem is small), else for as many loads as fit in that budget; none where the refined "
-      "problem would not fit in memory. Variants within 3x of it are flagged 'not resolved by "
-      "this reference'.");
+      "on the same mesh; needs degree = 1), lower_degree (degree 1 on the same mesh; needs "
+      "degree = 2: the difference bounds the reference's error from above), none. auto: degree "
+      "at degree 1; refine at degree 2 for every load if that costs at most 3x the reference's "
+      "own solves (or the refined problem is small), else for as many loads as fit in that "
+      "budget; lower_degree at degree 2 where no refined solve fits. Variants within 3x of it "
+      "are flagged 'not resolved by this reference'.");
   prm.leave_subsection();
   prm.enter_subsection("timing");
   prm.declare_entry("integrator", "symplectic_euler",
@@ -468,6 +470,10 @@ void extract_fem_timing_output(ParameterHandler& prm, CaseParameters& c) {
     throw InputError(
         "fem/error estimate = degree needs fem/degree = 1 (deal.II has no cubic tetrahedron to "
         "go above degree 2); use refine");
+  if (c.fem.error_estimate == FemParameters::ErrorEstimate::lower_degree && c.fem.degree != 2)
+    throw InputError(
+        "fem/error estimate = lower_degree needs fem/degree = 2 (it solves degree 1 "
+        "on the same mesh); use degree or refine");
   prm.leave_subsection();
   prm.enter_subsection("timing");
   c.timing = {setting<massspring::IntegratorKind>(prm, "integrator"), prm.get_double("dt"),
@@ -544,6 +550,7 @@ CaseParameters read_case(const std::filesystem::path& file,
   CaseParameters c;
   try {
     c = extract(prm);
+    check_consistency(c);
   } catch (const InputError& e) {
     throw InputError(file.string() + ": " + e.what());
   }

@@ -201,7 +201,9 @@ std::filesystem::path write_vertex_displacement_hdf5(const VolumeMesh& mesh,
     throw std::invalid_argument("displacement has " + std::to_string(displacement.rows()) +
                                 " rows for a mesh of " + std::to_string(mesh.num_vertices()) +
                                 " vertices");
-  detail::ensure_petsc_initialized();  // parallel HDF5 needs MPI, even on one process
+  // Parallel HDF5 needs MPI, even on one process; PETSc is not used here (its start is collective,
+  // and under mpirun only one rank writes the fields).
+  detail::ensure_mpi_initialized();
   Triangulation<3> triangulation;
   create_triangulation(mesh, triangulation);
   // P1 interpolates the vertex values exactly, so the patches carry them unchanged.

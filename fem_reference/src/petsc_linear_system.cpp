@@ -228,26 +228,30 @@ const char* method_name(Preconditioner p) {
 
 }  // namespace
 
-void ensure_petsc_initialized() {
+void ensure_mpi_initialized() {
   int mpi_ready = 0;
   MPI_Initialized(&mpi_ready);
-  if (!mpi_ready) {
-    int provided = 0;
-    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
-    mpi_initialized_here = true;
-  }
+  if (mpi_ready) return;
+  int provided = 0;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+  mpi_initialized_here = true;
+  static const bool registered = (std::atexit(finalize_mpi_if_ours), true);
+  (void)registered;
+}
+
+void ensure_petsc_initialized() {
+  ensure_mpi_initialized();
   PetscBool petsc_ready = PETSC_FALSE;
   PetscInitialized(&petsc_ready);
-  if (!petsc_ready) {
-    MSFEM_PETSC(PetscInitializeNoArguments());
-    int key = MPI_KEYVAL_INVALID;
-    MPI_Comm_create_keyval(MPI_COMM_NULL_COPY_FN, finalize_petsc, &key, nullptr);
-    MPI_Comm_set_attr(MPI_COMM_SELF, key, nullptr);
-  }
-  if (mpi_initialized_here) {
-    static const bool registered = (std::atexit(finalize_mpi_if_ours), true);
-    (void)registered;
-  }
+  if (petsc_ready) return;
+  // PETSc's initialisation is collective on PETSC_COMM_WORLD. Each process starts it when it first
+  // needs it (under mpirun one rank may write a cached reference's fields while another runs a
+  // variant), so it is started on the process alone; every solve names its own communicator.
+  PETSC_COMM_WORLD = MPI_COMM_SELF;
+  MSFEM_PETSC(PetscInitializeNoArguments());
+  int key = MPI_KEYVAL_INVALID;
+  MPI_Comm_create_keyval(MPI_COMM_NULL_COPY_FN, finalize_petsc, &key, nullptr);
+  MPI_Comm_set_attr(MPI_COMM_SELF, key, nullptr);
 }
 
 PetscLinearSystem::PetscLinearSystem(MPI_Comm communicator, PetscInt global_rows,

@@ -12,8 +12,13 @@
 
 namespace msfem::fem_reference::detail {
 
+/// Initialises MPI unless the program already did; what this function initialised is finalised at
+/// exit.
+void ensure_mpi_initialized();
+
 /// Initialises MPI and PETSc unless the program already did (deal.II's MPI_InitFinalize, a test's
-/// main); what this function initialised is finalised at exit.
+/// main); what this function initialised is finalised at exit. Not collective: PETSc is started on
+/// this process alone.
 void ensure_petsc_initialized();
 
 struct KrylovReport {

@@ -49,8 +49,10 @@ TEST_P(HostileInput, IsRefusedAtOnceNamingTheFault) {
   write(dir / "empty.prm", "");
   const auto out = dir / "out";
   const std::string args = replace_dir(h.args, dir.path().string());
-  // simplify writes a file, not a folder, and takes no --out.
-  const bool folder = args.find("--out") == std::string::npos && args.rfind("simplify", 0) != 0;
+  // run, sweep and calibrate write a folder (--out); simplify and bench take none.
+  const bool folder =
+      args.find("--out") == std::string::npos &&
+      (args.rfind("run", 0) == 0 || args.rfind("sweep", 0) == 0 || args.rfind("calibrate", 0) == 0);
   const auto r = run_msfem(args + (folder ? " --out " + out.string() : std::string()));
   EXPECT_EQ(r.exit_code, 2) << r.err;
   std::size_t error_lines = 0;
@@ -65,6 +67,12 @@ TEST_P(HostileInput, IsRefusedAtOnceNamingTheFault) {
   EXPECT_NE(error.find(h.expected), std::string::npos) << error;
   EXPECT_EQ(r.err.find("solving the FEM"), std::string::npos) << "solved before refusing";
   EXPECT_FALSE(std::filesystem::exists(out));
+  // Nothing else either: no temporary, claim or half-written file.
+  // (The FEM cache's folder is made, empty, where the run would keep it.)
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_TRUE(entry.path().extension() == ".prm" ||
+                (entry.path().filename() == ".fem-cache" && std::filesystem::is_empty(entry)))
+        << entry.path();
 }
 
 const Hostile hostile[] = {
@@ -105,6 +113,52 @@ const Hostile hostile[] = {
      "calibrate " + sphere + " --train '0,0,1@0.005' --test '0,0.001,1@0.005'",
      "presses the same surface vertex"},
     {"EmptyOutPath", "run " + sphere + " --out ''", "empty path"},
+    // Numbers each key accepts alone that the case makes meaningless, refused before the FEM.
+    {"ToolDepthAtRoundOff", "run " + sphere + " --set loads/tool/depth=1e-7",
+     "loads/tool/depth = 1e-07 m is below"},
+    {"ToolDepthOfADenormal", "run " + sphere + " --set loads/tool/depth=1e-300",
+     "loads/tool/depth = 1e-300 m is below"},
+    {"CurveDepthZero", "run " + sphere + " --set 'loads/tool/curve depths=0,0.005'",
+     "loads/tool/curve depths = 0 m is below"},
+    {"GravityOfAThousandG", "run " + sphere + " --set 'loads/gravity=0,0,-1e4'",
+     "loads/gravity would move the surface about"},
+    {"PatchForceOfAMegaNewton",
+     "run " + sphere +
+         " --set 'loads/patch force/enabled=true' --set 'loads/patch force/force=1e6,0,0'",
+     "loads/patch force/force would move the surface about"},
+    {"TimeStepAtRoundOff", "run " + sphere + " --set timing/dt=1e-300",
+     "timing/dt = 1e-300 s is below"},
+    {"HuTableOfADenormalModulus",
+     "run " + sphere + " --set 'material/youngs modulus image=" + cases_dir +
+         "/data/abdomen_ct_3mm.nii.gz' --set 'material/hu to youngs=0:1e-300; 100:3000'",
+     "material/hu to youngs: 0:1e-300 gives E outside"},
+    {"HuTableOfNoContrastLimit",
+     "run " + sphere + " --set 'material/youngs modulus image=" + cases_dir +
+         "/data/abdomen_ct_3mm.nii.gz' --set 'material/hu to youngs=0:0.01; 100:1e11'",
+     "a contrast above"},
+    // Settings that would be ignored.
+    {"HuTableWithoutImage", "run " + sphere + " --set 'material/hu to youngs=0:3000; 100:5000'",
+     "material/hu to youngs is set but material/youngs modulus image is empty"},
+    {"RefinementSizeWithRefinementOff",
+     "run " + sphere + " --set 'mass spring/contact refinement/edge length=0.001'",
+     "contact refinement: radius or edge length is set but enabled = false"},
+    {"VolumePreservationWithoutVolumeElements",
+     "run " + sphere +
+         " --set 'mass spring/variants=single_layer' --set 'mass spring/volume preservation=true'",
+     "none of mass spring/variants has volume elements"},
+    {"UnitOfAGeneratedSurface", "run " + sphere + " --set geometry/unit=mm",
+     "geometry/unit = mm has no effect on a generated surface"},
+    {"SweepOfNoResolution", "sweep " + sphere + " --resolutions ''",
+     "option --resolutions: '' lists no value"},
+    {"RepeatedOption", "sweep " + sphere + " --resolutions 2 --resolutions 3",
+     "option --resolutions is given twice"},
+    {"BenchOnAHundredThousandThreads", "bench massspring --threads 100000",
+     "option --threads 100000 is outside [1, 256]"},
+    {"SimplifySmoothedAMillionTimes",
+     "simplify " + cases_dir +
+         "/data/pancreas_vh_female_m.obj {dir}/p.obj --vertices 446 "
+         "--smooth 1000000",
+     "option --smooth 1000000 is outside [0, 1000]"},
     {"SimplifyOntoItsInput",
      "simplify " + cases_dir + "/data/pancreas_vh_female_m.obj " + cases_dir +
          "/data/pancreas_vh_female_m.obj --vertices 446",

@@ -2,6 +2,7 @@
 // one-rank answer, printed once and written once.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -226,6 +227,59 @@ TEST(CliMpi, BadInputOnTwoRanksExitsTwoOnceAndWritesNothing) {
   EXPECT_EQ(occurrences(taken.err, "output folder exists and is not empty"), 1u) << taken.err;
   EXPECT_FALSE(std::filesystem::exists(tmp / "a"));
   EXPECT_EQ(read_text(tmp / "full" / "keep.txt"), "a user's file\n");
+}
+
+// The second run of a case takes its FEM from the cache, so rank 0 writes the reference's fields
+// without having solved it: nothing it does there may wait for the other rank.
+TEST(CliMpi, ASecondRunFromTheCacheEndsWithTheFirstRunsNumbers) {
+  const std::string mpirun = find_mpirun();
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";
+  TemporaryDirectory tmp;
+  const std::string args = "run " + std::string(MSFEM_TEST_DATA_DIR) +
+                           "/small_sphere.prm --quiet --no-timing --set 'fem/error estimate=none'"
+                           " --out ";
+  const auto a = run_msfem_on_two_ranks(mpirun, args + (tmp / "A").string());
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const auto b = run_msfem_on_two_ranks(mpirun, args + (tmp / "B").string());
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const auto x = nlohmann::json::parse(read_text(tmp / "A" / "summary.json"));
+  const auto y = nlohmann::json::parse(read_text(tmp / "B" / "summary.json"));
+  EXPECT_FALSE(x["fem"]["from_cache"].get<bool>());
+  EXPECT_TRUE(y["fem"]["from_cache"].get<bool>());
+  int compared = 0;
+  nlohmann::json xf = x, yf = y;
+  xf["fem"].erase("from_cache");
+  yf["fem"].erase("from_cache");
+  expect_same_numbers(xf, yf, "summary.json", 1e-12, compared);
+  EXPECT_GT(compared, 100);
+  for (const auto& entry : std::filesystem::directory_iterator(tmp.path()))
+    EXPECT_TRUE(entry.path().filename() == "A" || entry.path().filename() == "B" ||
+                entry.path().filename() == ".fem-cache")
+        << entry.path();
+}
+
+// A variant that fails on one rank while the other has nothing left to do: the job ends at once
+// with the variant's message, whether the FEM was solved or read from the cache.
+TEST(CliMpi, AFailingVariantWithACachedReferenceEndsPromptlyWithItsMessage) {
+  const std::string mpirun = find_mpirun();
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";
+  TemporaryDirectory tmp;
+  // A tool four times the organ's size: three_tier's Newton does not converge under it.
+  const std::string args = "run " + std::string(MSFEM_CASES_DIR) +
+                           "/sphere_indent.prm --quiet --no-timing --set "
+                           "geometry/source=icosphere:2:0.05 --set fem/degree=1 --set 'fem/error "
+                           "estimate=none' --set loads/tool/radius=0.2 --out ";
+  for (const char* out : {"A", "B"}) {
+    const auto start = std::chrono::steady_clock::now();
+    const auto r = run_msfem_on_two_ranks(mpirun, args + (tmp / out).string());
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(r.exit_code, 1) << out << r.err;
+    EXPECT_NE(r.err.find("variant three_tier failed: variant three_tier: Newton did not converge"),
+              std::string::npos)
+        << out << r.err;
+    EXPECT_LT(seconds, 10.0) << out;
+  }
 }
 
 }  // namespace

@@ -40,8 +40,8 @@ TEST_F(Regress, UnchangedModelPassesAndPrintsTheTable) {
   EXPECT_NE(r.out.find("0 failed"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("surface_displacement"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(read_text(baseline_file()));
-  for (const char* key : {"format_version", "case_file_hash", "mesh_hash", "units", "degree",
-                          "git_revision", "date", "fields_file", "variants"})
+  for (const char* key : {"format_version", "case_file_hash", "mesh_hash", "reference_hash",
+                          "units", "degree", "git_revision", "date", "fields_file", "variants"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 
@@ -82,6 +82,17 @@ TEST_F(Regress, EditedCaseIsAStaleBaseline) {
   const auto r = regress();
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_NE(r.out.find("stale baseline, run --update"), std::string::npos) << r.out;
+}
+
+// The same case file with --set another material is another problem: STALE, not a metric-by-metric
+// verdict against numbers of a different reference.
+TEST_F(Regress, AnotherProblemThroughSetIsAStaleBaseline) {
+  const auto r = regress("--set 'material/poisson ratio=0.3'");
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("reference_hash"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("STALE"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("WORSE"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" 0 improved"), std::string::npos) << r.out;
 }
 
 TEST_F(Regress, NonFiniteValueInTheBaselineFieldFails) {

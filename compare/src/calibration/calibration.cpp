@@ -238,7 +238,7 @@ class GroupFit {
                                    const std::vector<double>& theta) const {
     if (!options_.linear)
       return evaluate_all(m, references, stiffness_at(theta), fields_at(theta),
-                          problem_.parameters.loads.tool.path_step_m);
+                          path_step_of(problem_.parameters.loads.tool));
     // Parts: the unfitted springs, each fitted spring group, and the volume (LinearisedStatics
     // puts it last); the volume group's own part stays empty.
     std::vector<double> weights(n_ + 1, 1.0);

@@ -267,7 +267,7 @@ void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& para
   BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
   Eigen::VectorXd x;
   const LoadErrors check =
-      evaluate_load(built, c.train.front(), x, c.problem.parameters.loads.tool.path_step_m);
+      evaluate_load(built, c.train.front(), x, path_step_of(c.problem.parameters.loads.tool));
   c.nonlinear_check = check;
   if (c.options.linear)
     c.notes.push_back(
@@ -322,7 +322,7 @@ void compare_on_held_out_loads(CaseCalibration& c, const cases::CaseParameters& 
           errors.push_back(
               c.options.linear
                   ? evaluate_load_linear(other, r)
-                  : evaluate_load(other, r, xo, c.problem.parameters.loads.tool.path_step_m));
+                  : evaluate_load(other, r, xo, path_step_of(c.problem.parameters.loads.tool)));
         }
       } catch (const std::runtime_error& e) {
         // A comparison only: say so and go on, the calibration itself stands.

@@ -88,15 +88,12 @@ int bench_massspring(const Options& options) {
   }
 
   massspring::SteppingBenchmarkOptions bench_options;
-  bench_options.threads = static_cast<int>(options.integer("threads", 2));
-  bench_options.samples = static_cast<int>(options.integer("samples", 5));
+  // Bounded so that a typo is an error, not a machine's worth of threads or an hour's run.
+  bench_options.threads = static_cast<int>(options.integer("threads", 2, 1, 256));
+  bench_options.samples = static_cast<int>(options.integer("samples", 5, 1, 1000));
   bench_options.single_precision = options.flag("float");
-  if (const auto seconds = options.value("seconds"))
-    bench_options.seconds_per_sample = std::stod(*seconds);
-  if (bench_options.threads < 1) throw std::invalid_argument("option --threads must be >= 1");
-  if (bench_options.samples < 1) throw std::invalid_argument("option --samples must be >= 1");
-  if (!(bench_options.seconds_per_sample > 0.0))
-    throw std::invalid_argument("option --seconds must be > 0");
+  bench_options.seconds_per_sample =
+      options.number("seconds", bench_options.seconds_per_sample, 0.0, 600.0);
 
   // The roofline: a memory-bound step can go no faster than this machine streams its bytes.
   const double stream = massspring::stream_triad_bandwidth(bench_options.threads);

@@ -27,11 +27,10 @@ cases::ImageSurfaceOptions parse_options(const Options& opt) {
   if (opt.value("threshold"))
     o.selection = cases::parse_threshold(*opt.value("threshold"), "option --threshold");
   const long vertices = opt.integer("vertices", 0);
-  const long smoothing = opt.integer("smooth", 0);
+  const long smoothing = opt.integer("smooth", 0, 0, 1000);
   if (opt.value("vertices") && vertices < 4)
     throw std::invalid_argument("option --vertices " + std::to_string(vertices) +
                                 " is too small: a closed surface needs at least 4");
-  if (smoothing < 0) throw std::invalid_argument("option --smooth must be >= 0");
   o.target_vertices = static_cast<int>(vertices);
   o.smoothing_iterations = static_cast<int>(smoothing);
   return o;

@@ -43,6 +43,9 @@ std::vector<int> integers(const std::string& option, const std::string& text) {
       throw std::invalid_argument("option --" + option + ": '" + p + "' is not a positive integer");
     values.push_back(v);
   }
+  // An empty list would run the default sweep, not the one asked for.
+  if (values.empty())
+    throw std::invalid_argument("option --" + option + ": '" + text + "' lists no value");
   return values;
 }
 

@@ -137,6 +137,22 @@ void reference_at_every_load(CaseRun& run, const RunSettings& settings, const Pr
   run.fem_force_depth_monotone = force_grows_with_depth(run.loads.front().force_depth, tool);
 }
 
+// A variant that holds the tool with no force where the FEM pushes back has lost it (passed
+// through its surface or slid off): a force error of 1 would read as an answer, so the variant
+// fails with the reason.
+void check_tool_felt(const BuiltVariant& built, const Eigen::Vector3d& force,
+                     const Eigen::Vector3d& fem_force, const ToolPlacement& tool) {
+  const double fem_push = fem_force.dot(tool.outward_normal);
+  if (!(fem_push > 0) || force.norm() > 1e-9 * fem_force.norm()) return;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "variant %s: the tool at %.3g mm feels %.3g N where the FEM pushes back with "
+                "%.3g N: it lost the surface (a finer loads/tool/path step presses it from the "
+                "last equilibrium)",
+                built.name.c_str(), 1e3 * tool.depth, force.norm(), fem_push);
+  throw std::runtime_error(text);
+}
+
 // The variant's equilibrium `s` (reached along `curve`) against the FEM's at the same load.
 ToolLoadVariant compare_at_load(const Problem& problem, const BuiltVariant& built,
                                 const StaticSolution& s, std::vector<ForceDepthPoint> curve,
@@ -151,7 +167,10 @@ ToolLoadVariant compare_at_load(const Problem& problem, const BuiltVariant& buil
                                       tool ? tool->contact_point : problem.centroid,
                                       tool ? 2 * tool->radius : 0.0);
   o.tool_force = s.tool_force;
-  if (tool) o.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, fem.tool_force);
+  if (tool) {
+    check_tool_felt(built, s.tool_force, fem.tool_force, *tool);
+    o.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, fem.tool_force);
+  }
   o.volume_change = volume_change(problem.surface, s.surface_displacement);
   o.inverted_elements = inverted_tetrahedra(built, s.x);
   o.force_depth_monotone = force_grows_with_depth(curve, tool);
@@ -330,6 +349,13 @@ std::vector<double> loading_path(std::vector<double> depths, double case_depth, 
   return path;
 }
 
+double path_step_of(const cases::ToolParameters& tool) {
+  const double step = tool.path_step_m;
+  if (tool.mode != cases::ToolParameters::Mode::contact) return step;
+  const double limit = 0.25 * tool.radius_m;
+  return step > 0 ? std::min(step, limit) : limit;
+}
+
 std::optional<double> force_depth_exponent(const std::vector<ForceDepthPoint>& curve,
                                            const std::optional<ToolPlacement>& tool) {
   if (!tool || curve.size() < 2) return std::nullopt;
@@ -391,7 +417,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   // output, never the path the variants are pressed along (their equilibria would differ).
   const std::vector<double> path =
       tool ? loading_path(curve_depths(parameters.loads.tool), tool->depth,
-                          parameters.loads.tool.path_step_m)
+                          path_step_of(parameters.loads.tool))
            : std::vector<double>{};
   if (ranks::count() > 1)
     detail::run_variants_across_ranks(run, path, settings, progress);

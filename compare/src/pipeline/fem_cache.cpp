@@ -87,12 +87,11 @@ std::optional<fem_reference::ContactReport> contact_from(const nlohmann::json& j
 
 }  // namespace
 
-std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacement>& refine_near,
-                          const std::optional<ToolPlacement>& tool,
-                          const std::vector<double>& curve_depths) {
+std::string reference_inputs_hash(const Problem& problem,
+                                  const std::vector<ToolPlacement>& refine_near,
+                                  const std::optional<ToolPlacement>& tool) {
   const auto& p = problem.parameters;
   ContentHash h;
-  h.text(cache_version);
   h.matrix(problem.surface.vertices);
   h.matrix(problem.surface.triangles);
   for (double x :
@@ -131,6 +130,15 @@ std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacemen
     h.number(tool->depth);
     h.text(tool->frictionless ? "contact" : "bonded");
   }
+  return h.hex();
+}
+
+std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacement>& refine_near,
+                          const std::optional<ToolPlacement>& tool,
+                          const std::vector<double>& curve_depths) {
+  ContentHash h;
+  h.text(cache_version);
+  h.text(reference_inputs_hash(problem, refine_near, tool));
   for (double d : curve_depths)
     h.number(d);
   return h.hex();

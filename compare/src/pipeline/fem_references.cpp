@@ -1,8 +1,10 @@
 #include "msfem/compare/pipeline/fem_references.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/surface.hpp"
 #include "msfem/compare/pipeline/fem_cache.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
@@ -106,6 +108,25 @@ void solve_fresh(const Problem& problem, FemReferences& r, const ReferenceReques
   }
 }
 
+// A load that moves the surface by more than half the model's smallest extent (the estimates in
+// make_problem let through what they cannot size: a soft image, a support far from the load) is
+// outside small-strain elasticity: the reference, and any error measured against it, says nothing.
+void check_small_strain(const Problem& problem, const FemReferences& r) {
+  const Eigen::Matrix<double, 2, 3> box = cases::bounding_box(problem.surface);
+  const double extent = (box.row(1) - box.row(0)).minCoeff();
+  for (std::size_t i = 0; i < r.loads.size(); ++i) {
+    const double moved = r.loads[i].fem.surface_displacement.rowwise().norm().maxCoeff();
+    if (moved <= 0.5 * extent) continue;
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  ": the FEM reference moves the surface %.3g m at load %zu, more than half the "
+                  "model's smallest extent (%.3g m): outside the small strains linear elasticity "
+                  "holds for (loads/gravity, loads/patch force/force, material/youngs modulus)",
+                  moved, i + 1, extent);
+    throw cases::InputError(problem.parameters.file.string() + text);
+  }
+}
+
 }  // namespace
 
 std::vector<int> unprescribed_vertices(const Problem& problem,
@@ -145,6 +166,7 @@ FemReferences fem_references(const Problem& problem, const ReferenceRequest& req
                    "): nothing it depends on changed");
   solve_fresh(problem, r, request, cached, progress);
   take_cached(r, cached);
+  check_small_strain(problem, r);
   if (r.mesh.num_tetrahedra() > 0)
     r.worst_cell_quality = fem_reference::cell_quality(r.mesh).minCoeff();
   return r;

@@ -229,6 +229,63 @@ void refine_at_tools(Problem& problem) {
   problem.local_refinement = local;
 }
 
+// Below this fraction of the model's smallest extent a tool's depth moves the surface by about the
+// solvers' own tolerance: the forces are round-off and every error reads 1.
+constexpr double smallest_depth_fraction = 1e-4;
+// A load whose small-strain estimate moves the surface by more than this many of the model's
+// smallest extents is outside what a linear-elastic reference (or a comparison with it) can say.
+constexpr double largest_strain_estimate = 5.0;
+
+void check_tool_depths(const cases::CaseParameters& p, double extent) {
+  const auto& tool = p.loads.tool;
+  const double least = smallest_depth_fraction * extent;
+  std::vector<std::pair<std::string, double>> depths = {{"loads/tool/depth", tool.depth_m}};
+  for (double d : tool.curve_depths_m)
+    depths.emplace_back("loads/tool/curve depths", d);
+  for (const auto& [key, depth] : depths)
+    if (!(depth >= least)) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    ": %s = %g m is below %g m (1e-4 of the model's smallest extent, %g m): the "
+                    "tool would move the surface by about the solvers' tolerance",
+                    key.c_str(), depth, least, extent);
+      throw cases::InputError(p.file.string() + text);
+    }
+}
+
+// Gravity and a patch force, estimated as linear elasticity would size them before anything is
+// solved: self-weight sags about rho |g| L^2 / E (L the smallest extent), a pressure on a disc of
+// radius a moves it about 2 (1 - nu^2) F / (pi a E) (Timoshenko & Goodier, the uniformly loaded
+// circle).
+void check_load_magnitudes(const cases::CaseParameters& p, double extent) {
+  const auto& m = p.material;
+  const double e = m.youngs_modulus_pa;
+  const double gravity =
+      m.density_kg_per_m3 * p.loads.gravity_m_per_s2.norm() * extent * extent / e;
+  const auto& patch = p.loads.patch_force;
+  const double pull = patch.enabled ? 2 * (1 - m.poisson_ratio * m.poisson_ratio) *
+                                          patch.force_n.norm() / (M_PI * patch.radius_m * e)
+                                    : 0.0;
+  for (const auto& [key, estimate] : {std::pair<const char*, double>{"loads/gravity", gravity},
+                                      {"loads/patch force/force", pull}})
+    if (estimate > largest_strain_estimate * extent) {
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    ": %s would move the surface about %.3g m with material/youngs modulus = %g "
+                    "Pa, %.3g times the model's smallest extent (%.3g m): far outside the small "
+                    "strains a linear-elastic reference holds for",
+                    key, estimate, e, estimate / extent, extent);
+      throw cases::InputError(p.file.string() + text);
+    }
+}
+
+void check_loads_in_range(const cases::CaseParameters& p, const cases::Surface& s) {
+  const Eigen::Matrix<double, 2, 3> box = cases::bounding_box(s);
+  const Eigen::Vector3d extent = (box.row(1) - box.row(0)).transpose();
+  if (p.loads.tool.enabled) check_tool_depths(p, extent.minCoeff());
+  check_load_magnitudes(p, extent.minCoeff());
+}
+
 // The CT whose HU give E, checked to cover the organ: a surface outside the scan (another
 // patient's image, millimetres read as metres) would take E from the image's edge unnoticed.
 void load_youngs_modulus_image(Problem& problem) {
@@ -338,6 +395,7 @@ Problem make_problem(const cases::CaseParameters& parameters) {
     throw cases::InputError(parameters.file.string() +
                             ": support: the fixed region contains the whole surface");
 
+  check_loads_in_range(parameters, s);
   if (parameters.loads.tool.enabled) {
     const Eigen::MatrixX3d normals = cases::vertex_normals(s);
     for (const auto& d : parameters.loads.tool.directions) {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "msfem/compare/pipeline/content_hash.hpp"
+#include "msfem/compare/pipeline/fem_cache.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/fields_h5.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
@@ -110,6 +111,13 @@ void compare_field(const std::string& case_name, const ToolLoadVariant& v,
   rows.push_back(row);
 }
 
+std::string reference_hash(const CaseRun& run) {
+  const std::vector<ToolPlacement>& tools = run.problem.tools;
+  return reference_inputs_hash(
+      run.problem, tools,
+      tools.empty() ? std::nullopt : std::optional<ToolPlacement>(tools.front()));
+}
+
 }  // namespace
 
 const std::vector<std::string>& regression_metrics() {
@@ -158,6 +166,7 @@ nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& d
                                    {"case_file", p.file.lexically_normal().string()},
                                    {"case_file_hash", file_hash(p.file)},
                                    {"mesh_hash", surface_hash(run.problem.surface)},
+                                   {"reference_hash", reference_hash(run)},
                                    {"units", {{"length", "m"}}},
                                    {"degree", p.fem.degree},
                                    {"git_revision", git_revision()},
@@ -190,6 +199,13 @@ std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohm
   if (base.value("mesh_hash", "") != surface_hash(run.problem.surface))
     header("mesh_hash (stale baseline, run --update)", base.value("mesh_hash", ""),
            surface_hash(run.problem.surface));
+  // The same file run with --set another material, load or support solves another problem: its
+  // numbers are not comparable, metric by metric, with the baseline's.
+  if (base.value("reference_hash", "") != reference_hash(run))
+    header(
+        "reference_hash (another FEM problem: material, loads, supports or fem settings "
+        "differ from the baseline's; run --update)",
+        base.value("reference_hash", "(none)"), reference_hash(run));
   if (!rows.empty()) return rows;
   const auto& variants = base.at("variants");
   for (const auto& v : run.variants) {

@@ -1,11 +1,14 @@
 #include "msfem/compare/writers/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <system_error>
 
@@ -90,6 +93,51 @@ void remove_quietly(const fs::path& path) {
   fs::remove(path, ignored);
 }
 
+// A claim on a result folder, DIR.lock holding the claiming process's id, taken before any work: a
+// second run given the same --out is refused at once instead of computing for minutes and then
+// failing on the rename. A claim whose process has died (killed without its handlers) is taken
+// over.
+class FolderClaim {
+ public:
+  explicit FolderClaim(const fs::path& directory)
+      : path_(directory.parent_path() / (directory.filename().string() + ".lock")) {
+    if (!directory.parent_path().empty()) {
+      std::error_code ignored;
+      fs::create_directories(directory.parent_path(), ignored);
+    }
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+      if (fd >= 0) {
+        const std::string pid = std::to_string(::getpid()) + "\n";
+        const bool written = ::write(fd, pid.data(), pid.size()) == ssize_t(pid.size());
+        ::close(fd);
+        if (!written) break;
+        pending_ = std::make_unique<PendingTemporary>(path_);
+        return;
+      }
+      if (errno != EEXIST) break;
+      long holder = 0;
+      std::ifstream(path_) >> holder;
+      if (holder > 0 && (::kill(pid_t(holder), 0) == 0 || errno == EPERM))
+        throw cases::InputError(directory.string() + ": another msfem (process " +
+                                std::to_string(holder) + ") is writing this output folder");
+      remove_quietly(path_);
+    }
+    throw cases::InputError(directory.string() + ": cannot claim the output folder (" +
+                            path_.string() + ": " + std::strerror(errno) + ")");
+  }
+  ~FolderClaim() {
+    pending_.reset();
+    remove_quietly(path_);
+  }
+  FolderClaim(const FolderClaim&) = delete;
+  FolderClaim& operator=(const FolderClaim&) = delete;
+
+ private:
+  fs::path path_;
+  std::unique_ptr<PendingTemporary> pending_;
+};
+
 }  // namespace
 
 void write_file_atomically(const fs::path& path,
@@ -130,6 +178,8 @@ void check_output_folder(const fs::path& directory) {
 void fill_directory_atomically(const fs::path& directory,
                                const std::function<void(const fs::path& work)>& fill) {
   check_output_folder(directory);
+  const FolderClaim claim(directory);
+  check_output_folder(directory);  // a run that finished while this one claimed
   const fs::path work = temporary_name_for(directory);
   const PendingTemporary pending(work);
   std::error_code created;

@@ -138,7 +138,7 @@ struct FemParameters {
   bool refine_at_tool = true;
   double tool_cell_size_m = 0.0;  ///< edge length there; 0: the tool radius / 3
   /// How the reference's own discretisation error is estimated (docs/harness.md).
-  enum class ErrorEstimate { automatic, refine, degree, none };
+  enum class ErrorEstimate { automatic, refine, degree, lower_degree, none };
   ErrorEstimate error_estimate = ErrorEstimate::automatic;
 };
 

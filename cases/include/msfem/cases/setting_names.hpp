@@ -58,10 +58,11 @@ inline constexpr NameTable<SupportParameters::Kind, 3> support_kind_table{{{
     {SupportParameters::Kind::sphere, "sphere"},
 }}};
 
-inline constexpr NameTable<FemParameters::ErrorEstimate, 4> error_estimate_table{{{
+inline constexpr NameTable<FemParameters::ErrorEstimate, 5> error_estimate_table{{{
     {FemParameters::ErrorEstimate::automatic, "auto"},
     {FemParameters::ErrorEstimate::refine, "refine"},
     {FemParameters::ErrorEstimate::degree, "degree"},
+    {FemParameters::ErrorEstimate::lower_degree, "lower_degree"},
     {FemParameters::ErrorEstimate::none, "none"},
 }}};
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <map>
@@ -60,6 +61,9 @@ class Options {
             throw std::invalid_argument("option --" + key + " needs a value");
           value = args[++i];
         }
+        // A second --out or --threads would silently win over the first: only --set repeats.
+        if (values_.count(key) && key != "set")
+          throw std::invalid_argument("option --" + key + " is given twice");
         values_[key].push_back(value);
       } else {
         throw std::invalid_argument("unknown option '" + a + "'");
@@ -94,6 +98,35 @@ class Options {
     }
     if (used != v->size() || v->empty())
       throw std::invalid_argument("option --" + key + ": '" + *v + "' is not an integer");
+    return result;
+  }
+
+  /// As integer(), and refused (naming the option and the range) outside [least, greatest].
+  long integer(const std::string& key, long fallback, long least, long greatest) const {
+    const long result = integer(key, fallback);
+    if (result < least || result > greatest)
+      throw std::invalid_argument("option --" + key + " " + std::to_string(result) +
+                                  " is outside [" + std::to_string(least) + ", " +
+                                  std::to_string(greatest) + "]");
+    return result;
+  }
+
+  /// The finite number given for --key, or `fallback`; refused outside (least, greatest].
+  double number(const std::string& key, double fallback, double least, double greatest) const {
+    const auto v = value(key);
+    if (!v) return fallback;
+    std::size_t used = 0;
+    double result = 0;
+    try {
+      result = std::stod(*v, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != v->size() || v->empty() || !std::isfinite(result))
+      throw std::invalid_argument("option --" + key + ": '" + *v + "' is not a number");
+    if (!(result > least) || result > greatest)
+      throw std::invalid_argument("option --" + key + " " + *v + " is outside (" +
+                                  std::to_string(least) + ", " + std::to_string(greatest) + "]");
     return result;
   }
 

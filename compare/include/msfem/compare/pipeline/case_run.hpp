@@ -105,6 +105,12 @@ std::vector<double> curve_depths(const cases::ToolParameters& tool);
 /// increasing order, with equal steps no longer than `step` (> 0) inserted from 0 up to each.
 std::vector<double> loading_path(std::vector<double> depths, double case_depth, double step);
 
+/// The largest depth increment of a tool's loading path: the case's path step, and for a
+/// frictionless tool at most a quarter of its radius (0: no limit). A frictionless sphere moved
+/// further in one static step can pass through the surface or slide off it and leave the network
+/// untouched, an equilibrium with no force.
+double path_step_of(const cases::ToolParameters& tool);
+
 /// The metrics (summary.json names) of `variant` at load `load` that lie within 3x the reference's
 /// own estimated error there: the reference does not resolve the variant's error in them.
 std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,

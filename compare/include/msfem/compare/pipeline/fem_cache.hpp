@@ -22,6 +22,12 @@ struct FemCacheEntry {
   FemErrorEstimate error_estimate;
 };
 
+/// A hash of everything the FEM reference at `tool` depends on (surface, material, supports, loads,
+/// mesh and solver settings): two runs with the same hash solve the same problem.
+std::string reference_inputs_hash(const Problem& problem,
+                                  const std::vector<ToolPlacement>& refine_near,
+                                  const std::optional<ToolPlacement>& tool);
+
 /// 16 hex digits of a 64-bit FNV-1a hash of what the FEM at one load depends on: the problem's FEM
 /// inputs, where its mesh is refined, the load's tool and its force-depth curve's depths.
 std::string fem_cache_key(const Problem& problem, const std::vector<ToolPlacement>& refine_near,
