@@ -92,11 +92,14 @@ TEST(PlanErrorEstimate, AutoKeepsWithinThreeTimesTheReferencesSolves) {
   EXPECT_EQ(plan.method, Method::refine);
   EXPECT_EQ(plan.loads, 1);
   EXPECT_NE(plan.note.find("first 1 of 4"), std::string::npos) << plan.note;
-  // 3 x 4 allows none: auto says so rather than exceed its budget; refine asked for runs anyway.
-  const ErrorEstimatePlan none =
+  // 3 x 4 allows none: auto keeps its budget with P1 on the same mesh at every load (an upper
+  // bound), rather than leave the reference without an error bar; refine asked for runs anyway.
+  const ErrorEstimatePlan bound =
       plan_error_estimate(problem_with(2, Method::automatic), mesh, 4, 4);
-  EXPECT_EQ(none.method, Method::none);
-  EXPECT_NE(none.note.find("not estimated"), std::string::npos) << none.note;
+  EXPECT_EQ(bound.method, Method::lower_degree);
+  EXPECT_EQ(bound.loads, 4);
+  EXPECT_EQ(bound.predicted_dofs, 3u * 1000u);  // P1: three per vertex of the 10^3 cube
+  EXPECT_NE(bound.note.find("upper bound"), std::string::npos) << bound.note;
   EXPECT_EQ(plan_error_estimate(problem_with(2, Method::refine), mesh, 4, 4).loads, 4);
   EXPECT_EQ(plan_error_estimate(problem_with(2, Method::automatic), mesh, 80, 4).loads, 4);
 }
@@ -105,8 +108,8 @@ TEST(PlanErrorEstimate, ASecondSolveAboveTheCapIsSkippedOrRefused) {
   const auto mesh = kuhn_cube(30);  // about 5 M DoFs refined at P2
   const ErrorEstimatePlan plan =
       plan_error_estimate(problem_with(2, Method::automatic), mesh, 1, 1);
-  EXPECT_EQ(plan.method, Method::none);
-  EXPECT_GT(plan.predicted_dofs, max_estimate_dofs);
+  EXPECT_EQ(plan.method, Method::lower_degree);
+  EXPECT_NE(plan.note.find("above the 4 M msfem attempts"), std::string::npos) << plan.note;
   try {
     plan_error_estimate(problem_with(2, Method::refine), mesh, 1, 1);
     ADD_FAILURE() << "an explicit refine above the cap must be refused";
@@ -116,6 +119,35 @@ TEST(PlanErrorEstimate, ASecondSolveAboveTheCapIsSkippedOrRefused) {
         << e.what();
   }
   EXPECT_EQ(plan_error_estimate(problem_with(2, Method::none), mesh, 1, 1).method, Method::none);
+}
+
+// lower_degree's P1 twin is the less accurate of the two, so the difference it measures is at
+// least the refined estimate of the P2 reference's error: an upper bound, never an underestimate.
+TEST(FemErrorEstimate, LowerDegreeBoundsTheRefinedEstimateFromAbove) {
+  auto parameters = cases::read_case(std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm");
+  parameters.fem.degree = 2;
+  const Problem problem = make_problem(parameters);
+  const auto mesh = mesh_problem(problem, problem.tools);
+  const auto tool = std::optional<ToolPlacement>(problem.tools.front());
+  const FemSolution reference = solve_fem(problem, mesh, tool);
+  std::vector<int> compared;
+  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
+  for (std::size_t v = 0; v < prescribed.size(); ++v)
+    if (!prescribed[v]) compared.push_back(int(v));
+  auto estimate = [&](Method method) {
+    Problem p = problem;
+    p.parameters.fem.error_estimate = method;
+    const auto plan = plan_error_estimate(p, mesh, 1, 1);
+    EXPECT_EQ(plan.method, method);
+    return estimate_fem_error(p, mesh, plan, {&reference}, {compared}, {tool}).loads.front();
+  };
+  const LoadErrorEstimate bound = estimate(Method::lower_degree);
+  const LoadErrorEstimate refined = estimate(Method::refine);
+  ASSERT_TRUE(bound.rel_l2_error && refined.rel_l2_error && bound.force_rel_error &&
+              refined.force_rel_error);
+  EXPECT_GT(*refined.rel_l2_error, 0.0);
+  EXPECT_GE(*bound.rel_l2_error, *refined.rel_l2_error);
+  EXPECT_GE(*bound.force_rel_error, *refined.force_rel_error);
 }
 
 // The bonded default twin's reference against one two refinements finer (about 3 M DoFs, several
