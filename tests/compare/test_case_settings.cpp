@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
@@ -47,10 +48,13 @@ std::string case_text(const std::string& path, const std::string& value) {
 // Every name of Enum's table, set at `key`, is read back as its value; a name not in the table is
 // refused when the file is read, with the file and the line of the `set`.
 template <typename Enum, typename Get>
-void expect_language_takes_exactly_the_table(const std::string& key, Get get,
-                                             const std::vector<std::string>& also = {}) {
+void expect_language_takes_exactly_the_table(
+    const std::string& key, Get get, const std::vector<std::string>& also = {},
+    const std::map<std::string, std::string>& also_with_value = {}) {
   for (const auto& entry : cases::names_of(Enum{}).entries) {
     std::vector<std::string> overrides = also;
+    if (const auto it = also_with_value.find(entry.name); it != also_with_value.end())
+      overrides.push_back(it->second);
     overrides.push_back(key + "=" + entry.name);
     EXPECT_EQ(get(with(overrides)), entry.value) << key << " = " << entry.name;
   }
@@ -72,8 +76,10 @@ TEST(CaseSettings, EveryEnumeratedKeyTakesExactlyItsTable) {
   using cases::FemParameters;
   using cases::SupportParameters;
   using cases::ToolParameters;
+  // (A unit applies to a surface file only; a generated surface is refused one.)
   expect_language_takes_exactly_the_table<cases::LengthUnit>(
-      "geometry/unit", [](const CaseParameters& p) { return p.geometry.unit; });
+      "geometry/unit", [](const CaseParameters& p) { return p.geometry.unit; },
+      {"geometry/source=" + std::string(MSFEM_CASES_DIR) + "/data/pancreas_vh_female_m.obj"});
   expect_language_takes_exactly_the_table<SupportParameters::Kind>(
       "support/fixed region", [](const CaseParameters& p) { return p.support.kind; },
       {"support/sphere radius=0.01"});
@@ -90,7 +96,8 @@ TEST(CaseSettings, EveryEnumeratedKeyTakesExactlyItsTable) {
   expect_language_takes_exactly_the_table<cases::FemSolver>(
       "fem/solver", [](const CaseParameters& p) { return p.fem.solver; });
   expect_language_takes_exactly_the_table<FemParameters::ErrorEstimate>(
-      "fem/error estimate", [](const CaseParameters& p) { return p.fem.error_estimate; });
+      "fem/error estimate", [](const CaseParameters& p) { return p.fem.error_estimate; }, {},
+      {{"lower_degree", "fem/degree=2"}});
   expect_language_takes_exactly_the_table<massspring::IntegratorKind>(
       "timing/integrator", [](const CaseParameters& p) { return p.timing.integrator; });
   expect_language_takes_exactly_the_table<cases::CalibrationModel>(
@@ -105,8 +112,14 @@ TEST(CaseSettings, TheLengthUnitScalesTheFile) {
   TemporaryDirectory dir;
   cases::write_surface(dir / "ball.obj", cases::generate_surface("icosphere:2:50"));
   const std::string source = "geometry/source=" + (dir / "ball.obj").string();
+  // Deep enough to be more than round-off on the 100 m ball, shallow enough for the 10 cm one.
+  const std::vector<std::string> tool = {"loads/tool/depth=0.02",
+                                         "loads/tool/curve depths=0.01,0.02"};
   for (const cases::LengthUnit unit : cases::all_values<cases::LengthUnit>()) {
-    const Problem problem = make_problem(with({source, "geometry/unit=" + name_of(unit)}));
+    std::vector<std::string> overrides = tool;
+    overrides.push_back(source);
+    overrides.push_back("geometry/unit=" + name_of(unit));
+    const Problem problem = make_problem(with(overrides));
     const double radius = problem.surface.vertices.rowwise().norm().maxCoeff();
     EXPECT_NEAR(radius, 50 * cases::metres_per(unit), 1e-9 * radius) << name_of(unit);
   }
@@ -188,7 +201,10 @@ TEST(CaseSettings, EverySolverSolvesTheSameReference) {
 TEST(CaseSettings, EveryErrorEstimateIsPlannedAsAsked) {
   using Method = cases::FemParameters::ErrorEstimate;
   for (const Method method : cases::all_values<Method>()) {
-    const Problem problem = make_problem(with({"fem/error estimate=" + name_of(method)}));
+    // lower_degree estimates a P2 reference by P1; the others are asked of this case's P1.
+    const std::string degree = method == Method::lower_degree ? "2" : "1";
+    const Problem problem =
+        make_problem(with({"fem/error estimate=" + name_of(method), "fem/degree=" + degree}));
     const auto mesh = mesh_problem(problem);
     const Method planned = plan_error_estimate(problem, mesh, 1, 1).method;
     EXPECT_EQ(planned, method == Method::automatic ? Method::degree : method) << name_of(method);

@@ -1,7 +1,9 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
 
@@ -201,7 +203,31 @@ TEST(CliRun, AnInterruptedRunLeavesNeitherItsFolderNorItsTemporary) {
   EXPECT_EQ(read_text(tmp / "status"), "143\n");  // 128 + SIGTERM: the signal still ends it
   EXPECT_FALSE(std::filesystem::exists(out));
   for (const auto& entry : std::filesystem::directory_iterator(tmp.path()))
-    EXPECT_EQ(entry.path().filename().string().find("run.tmp."), std::string::npos) << entry.path();
+    EXPECT_TRUE(entry.path().filename().string().find("run.tmp.") == std::string::npos &&
+                entry.path().filename() != "run.lock")
+        << entry.path();
+}
+
+// A second run given the folder another run is filling is refused before any work; a claim left by
+// a process that no longer exists is taken over, and released at the end.
+TEST(CliRun, AFolderAnotherRunIsFillingIsRefusedAtOnce) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "run";
+  std::ofstream(tmp / "run.lock") << ::getpid() << "\n";
+  const auto taken = run_msfem("run " + small_case + " --quiet --no-timing --out " + out.string());
+  EXPECT_EQ(taken.exit_code, 2) << taken.err;
+  EXPECT_NE(taken.err.find("another msfem (process " + std::to_string(::getpid()) +
+                           ") is writing this output folder"),
+            std::string::npos)
+      << taken.err;
+  EXPECT_EQ(taken.err.find("solving the FEM"), std::string::npos) << taken.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  std::ofstream(tmp / "run.lock") << "4194303\n";  // above Linux's largest process id
+  const auto stale =
+      run_msfem("run " + small_case + " --quiet --no-timing --no-curve --out " + out.string());
+  EXPECT_EQ(stale.exit_code, 0) << stale.err;
+  EXPECT_TRUE(std::filesystem::exists(out / "summary.json"));
+  EXPECT_FALSE(std::filesystem::exists(tmp / "run.lock"));
 }
 
 TEST(CliRun, AVariantThatFailsIsReportedAndTheOthersAreStillCompared) {
@@ -329,6 +355,31 @@ TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
   EXPECT_EQ(b["tools"][0]["mode"], "bonded");
   EXPECT_TRUE(b["fem"]["contact"].is_null());
   EXPECT_NE(b["fem"]["cache_key"], fem["cache_key"]);
+}
+
+// A frictionless tool whose only curve depth is the case's is still pressed in steps of a quarter
+// of its radius: pressed there from rest at once, the sphere's centre sat on the pole node and
+// three_tier reported 0 N. The equilibrium is the default path's, to the solver's precision.
+TEST(CliRun, AContactToolWithOneCurveDepthIsPressedAsTheDefaultPathPressesIt) {
+  TemporaryDirectory tmp;
+  const std::string cheap =
+      "run " + std::string(MSFEM_CASES_DIR) +
+      "/sphere_indent.prm --quiet --no-timing --set geometry/source=icosphere:2:0.05 --set "
+      "fem/degree=1 --set 'fem/error estimate=none' --set 'mass spring/variants=three_tier' ";
+  const auto one =
+      run_msfem(cheap + "--set 'loads/tool/curve depths=0.005' --out " + (tmp / "one").string());
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  const auto quarters = run_msfem(cheap + "--out " + (tmp / "quarters").string());
+  ASSERT_EQ(quarters.exit_code, 0) << quarters.err;
+  const auto a = nlohmann::json::parse(read_text(tmp / "one" / "summary.json"));
+  const auto b = nlohmann::json::parse(read_text(tmp / "quarters" / "summary.json"));
+  const double fem = a["fem"]["reaction_force_N"][2].get<double>();
+  const double force = a["variants"][0]["reaction_force_N"][2].get<double>();
+  EXPECT_GT(force, 0.5 * fem);
+  EXPECT_NEAR(force, b["variants"][0]["reaction_force_N"][2].get<double>(), 1e-9 * force);
+  // (The two runs' FEM references are separate solves, equal to their tolerance.)
+  const double error = b["variants"][0]["rel_l2_error"].get<double>();
+  EXPECT_NEAR(a["variants"][0]["rel_l2_error"].get<double>(), error, 1e-8 * error);
 }
 
 // The local point distribution refines the one surface both models are built on: the case's

@@ -34,6 +34,26 @@ TEST(LoadingPath, StepsAreEqualWithinEachIntervalNoLongerThanAskedAndKeepTheReco
   EXPECT_EQ(loading_path({0.002, 0.004}, 0.004, 0.01), (std::vector<double>{0.002, 0.004}));
 }
 
+// A frictionless sphere moves at most a quarter of its radius per static step, whatever the path
+// step; a bonded patch keeps the case's path step.
+TEST(LoadingPath, AFrictionlessToolStepsAtMostAQuarterOfItsRadius) {
+  cases::ToolParameters tool;
+  tool.radius_m = 0.004;
+  tool.mode = cases::ToolParameters::Mode::contact;
+  EXPECT_EQ(path_step_of(tool), 0.001);
+  tool.path_step_m = 0.0005;
+  EXPECT_EQ(path_step_of(tool), 0.0005);
+  tool.path_step_m = 0.003;
+  EXPECT_EQ(path_step_of(tool), 0.001);
+  // A single curve depth at the case's depth: four equal steps, not one jump from rest.
+  EXPECT_EQ(loading_path({0.004}, 0.004, path_step_of(tool)),
+            (std::vector<double>{0.001, 0.002, 0.003, 0.004}));
+  tool.mode = cases::ToolParameters::Mode::prescribed;
+  EXPECT_EQ(path_step_of(tool), 0.003);
+  tool.path_step_m = 0;
+  EXPECT_EQ(path_step_of(tool), 0.0);
+}
+
 BuiltVariant one_tetrahedron() {
   Eigen::MatrixX3d v(4, 3);
   v << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
