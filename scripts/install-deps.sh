@@ -17,6 +17,7 @@ packages=(
   libgtest-dev           # unit and end-to-end tests
   libbenchmark-dev       # speed measurements
   gnuplot-nox            # plots in report.md
+  python3                # CI's check of the embedding example reads summary.json
   clang libclang-rt-14-dev  # libFuzzer (clang's) for the reader fuzz targets CI runs (scripts/fuzz.sh)
 )
 
