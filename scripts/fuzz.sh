@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (tests/fuzz) with clang, seeds each corpus from the project's own
-# files (cases/data surfaces by format, cases/*.prm) and runs each target for a bounded time:
+# files (cases/data surfaces by format, cases/*.prm; tiny NIfTI images from the tests' writer, plain
+# and gzipped) and runs each target for a bounded time:
 #   bash scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 60)
 # Exits non-zero on the first crash, leak, hang (-timeout) or sanitizer report; the input that
 # caused it is left in build-fuzz/ as crash-*, leak-* or timeout-*.
@@ -9,11 +10,17 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 CC=clang CXX=clang++ cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build-fuzz -j "${MSFEM_JOBS:-2}"
-for format in obj stl off ply case; do
+for format in obj stl off ply case nifti; do
   corpus=build-fuzz/corpus/$format
   mkdir -p "$corpus"
   if [ "$format" = case ]; then
     cp cases/*.prm tests/compare/data/*.prm "$corpus"/
+  elif [ "$format" = nifti ]; then
+    # The cases' scans are megabytes: written seeds of a few hundred bytes mutate faster.
+    build-fuzz/nifti_seeds "$corpus" >/dev/null
+    for seed in "$corpus"/v1_le_int16.nii "$corpus"/v2_be_float32.nii; do
+      gzip -c "$seed" >"$seed.gz"
+    done
   else
     # Small seeds only: libFuzzer mutates them, and -max_len caps what it grows them to.
     find cases/data tests -name "*.$format" -size -200k -exec cp {} "$corpus"/ \; 2>/dev/null || true

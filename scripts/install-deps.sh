@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages msfem needs; skips what is present, runs `apt-get update` at most once.
+#   bash scripts/install-deps.sh [--run-only]   (--run-only: not the test suite's own tools)
 set -euo pipefail
 
 packages=(
@@ -17,9 +18,13 @@ packages=(
   libgtest-dev           # unit and end-to-end tests
   libbenchmark-dev       # speed measurements
   gnuplot-nox            # plots in report.md
+)
+# What only the test suite and CI use; `--run-only` (the README's first command) leaves them out.
+test_packages=(
   python3                # CI's check of the embedding example reads summary.json
   clang libclang-rt-14-dev  # libFuzzer (clang's) for the reader fuzz targets CI runs (scripts/fuzz.sh)
 )
+[ "${1:-}" = "--run-only" ] || packages+=("${test_packages[@]}")
 
 missing=()
 for p in "${packages[@]}"; do
