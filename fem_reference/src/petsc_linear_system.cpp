@@ -19,10 +19,23 @@ std::string scientific(double x) {
   return text;
 }
 
+// PETSc's own handler prints a traceback of dozens of lines (once per rank under mpirun); msfem
+// reports a failure in one line, so the handler keeps the first message for check() to name.
+thread_local std::string petsc_message;
+
+PetscErrorCode keep_message(MPI_Comm, int, const char* function, const char*, PetscErrorCode code,
+                            PetscErrorType type, const char* message, void*) {
+  if (type == PETSC_ERROR_INITIAL)
+    petsc_message = std::string(message ? message : "") + " in " + (function ? function : "?");
+  return code;
+}
+
 void check(PetscErrorCode code, const char* call) {
-  if (code != 0)
-    throw FemError(std::string("PETSc call failed: ") + call + " (error " + std::to_string(code) +
-                   ")");
+  if (code == 0) return;
+  std::string what = std::string("PETSc call failed: ") + call + " (error " + std::to_string(code) +
+                     (petsc_message.empty() ? "" : ": " + petsc_message) + ")";
+  petsc_message.clear();
+  throw FemError(what);
 }
 #define MSFEM_PETSC(call) check((call), #call)
 
@@ -249,6 +262,7 @@ void ensure_petsc_initialized() {
   // variant), so it is started on the process alone; every solve names its own communicator.
   PETSC_COMM_WORLD = MPI_COMM_SELF;
   MSFEM_PETSC(PetscInitializeNoArguments());
+  MSFEM_PETSC(PetscPushErrorHandler(keep_message, nullptr));
   int key = MPI_KEYVAL_INVALID;
   MPI_Comm_create_keyval(MPI_COMM_NULL_COPY_FN, finalize_petsc, &key, nullptr);
   MPI_Comm_set_attr(MPI_COMM_SELF, key, nullptr);
