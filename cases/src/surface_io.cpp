@@ -205,6 +205,35 @@ void check_writable(const fs::path& file, const Surface& in_unit, const std::str
                                std::to_string(n) + ")");
 }
 
+/// Coordinates a million metres out, or a surface less than a micrometre across, are a wrong unit
+/// or a corrupt file; CGAL's predicates overflow or divide by zero on them (the alpha wrap dies
+/// with SIGFPE), so every reader's caller is spared them here.
+void check_scale(const fs::path& file, const Surface& s) {
+  constexpr double max_coordinate = 1e6, min_span = 1e-6;
+  const auto point = [&](Eigen::Index v) {
+    char text[96];
+    std::snprintf(text, sizeof text, "(%g, %g, %g)", s.vertices(v, 0), s.vertices(v, 1),
+                  s.vertices(v, 2));
+    return std::string(text);
+  };
+  for (Eigen::Index v = 0; v < s.num_vertices(); ++v)
+    if (!(s.vertices.row(v).cwiseAbs().maxCoeff() <= max_coordinate))
+      detail::fail(file, "vertex " + std::to_string(v + 1) + " (of " +
+                             std::to_string(s.num_vertices()) + ", in file order) is at " +
+                             point(v) +
+                             " m, more than 1e6 m from the origin: a wrong unit or a corrupt file");
+  const auto box = bounding_box(s);
+  const double span = (box.row(1) - box.row(0)).stableNorm();
+  if (!(span >= min_span)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the surface spans %g m (its bounding-box diagonal), less than 1e-6 m: a wrong "
+                  "unit or a corrupt file",
+                  span);
+    detail::fail(file, text);
+  }
+}
+
 /// Writes all bytes to `temporary` and renames it to `file`; on failure removes `temporary`.
 void put_on_disk(const fs::path& file, const fs::path& temporary, const std::string& bytes) {
   std::FILE* out = std::fopen(temporary.c_str(), "wb");
@@ -262,6 +291,7 @@ Surface read_surface(const fs::path& path, LengthUnit unit) {
   }
   if (surface.num_triangles() == 0) detail::fail(path, "no triangles");
   if (unit != LengthUnit::metre) surface.vertices /= units_per_metre(unit);
+  check_scale(path, surface);
   return surface;
 }
 

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <vector>
@@ -39,6 +40,10 @@ Soup to_soup(const Surface& s) {
   for (Eigen::Index v = 0; v < s.num_vertices(); ++v) {
     if (!s.vertices.row(v).allFinite())
       throw InputError("vertex " + std::to_string(v) + " has a non-finite coordinate");
+    // CGAL's predicates overflow past this (the alpha wrap dies with SIGFPE); read_surface refuses
+    // such files before, this guards surfaces made in memory.
+    if (!(s.vertices.row(v).cwiseAbs().maxCoeff() <= 1e6))
+      throw InputError("vertex " + std::to_string(v) + " is more than 1e6 m from the origin");
     soup.points.emplace_back(s.vertices(v, 0), s.vertices(v, 1), s.vertices(v, 2));
   }
   for (Eigen::Index t = 0; t < s.num_triangles(); ++t) {
@@ -204,6 +209,21 @@ Surface wrap(const Soup& cleaned, const RepairOptions& options, RepairReport& r)
   r.offset = options.offset.value_or(r.alpha / 30.0);
   if (!(r.alpha > 0) || !(r.offset > 0))
     throw InputError("the wrap's alpha and offset must be positive");
+  // The surface's size is the wrap's only scale: far below it the wrap refines for hours (alpha)
+  // or stalls on degenerate steps (offset), far above it CGAL's arithmetic overflows (SIGFPE).
+  const auto box = bounding_box(soup);
+  const double diagonal = (box.row(1) - box.row(0)).stableNorm();
+  const auto within = [&](const char* what, double value, double low, double high,
+                          const char* range) {
+    if (value >= low * diagonal && value <= high * diagonal) return;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the wrap's %s %g m must be %s the surface's bounding-box diagonal, %g m", what,
+                  value, range, diagonal);
+    throw InputError(text);
+  };
+  within("alpha", r.alpha, 1.0 / 500, 10.0, "between 1/500 and 10 times");
+  within("offset", r.offset, 1e-6, 1.0, "between 1e-6 and 1 times");
   // The wrap's faces are the weighted cells of a Delaunay triangulation and cannot fold, so only
   // what the options ask (largest piece, outward) is done to them; a new count would mislead.
   CgalMesh mesh = detail::to_cgal(detail::alpha_wrap_surface(soup, r.alpha, r.offset));

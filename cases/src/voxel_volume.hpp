@@ -29,8 +29,10 @@ struct VoxelVolume {
   std::vector<std::string> notes;  ///< which transform, which unit was assumed
 };
 
-/// Reads a 3-D NIfTI-1 or NIfTI-2 image (niftilib). Throws InputError naming the file: missing,
-/// not NIfTI or truncated, more than one volume, an unsupported voxel type, a singular transform.
+/// Reads a single-file 3-D NIfTI-1 or NIfTI-2 image, gzipped or not. Throws InputError naming the
+/// file and the header field or the voxel at fault: missing, not NIfTI or truncated, more than one
+/// volume, an unsupported voxel type, a voxel size, scale factor, vox_offset or transform that is
+/// not finite or out of bounds, a NaN or infinite voxel; so every value returned is finite.
 VoxelVolume read_nifti(const std::filesystem::path& file);
 
 using Mask = std::vector<std::uint8_t>;

@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
+#include <limits>
 #include <random>
 
 #include "msfem/cases/errors.hpp"
@@ -63,8 +66,24 @@ class ModulusImage : public ::testing::Test {
     testing::write_nifti(path, image);
     return path;
   }
+  // The refusal's message, or "" when the image is accepted.
+  std::string refusal(const std::filesystem::path& path) {
+    try {
+      YoungsModulusImage(path, parse_hu_to_youngs("0:3000; 100:7000", "t"));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  }
   std::filesystem::path dir_;
 };
+
+// HU 10 everywhere, stored as reals.
+NiftiImage real_image() {
+  NiftiImage image{3, 4, 2, {}};
+  image.reals.assign(24, 10.0f);
+  return image;
+}
 
 TEST_F(ModulusImage, InterpolatesEBetweenVoxelCentresInWorldCoordinates) {
   // HU = 10 i + 20 j + 40 k (stored as half of it, slope 2, intercept 0) on a rotated, anisotropic
@@ -121,6 +140,122 @@ TEST_F(ModulusImage, TheFingerprintFollowsTheVoxelsAndTheTable) {
   EXPECT_NE(YoungsModulusImage(path, parse_hu_to_youngs("0:3000; 100:8000", "t")).fingerprint(), a);
   image.values[13] = 11;
   EXPECT_NE(YoungsModulusImage(write(image), table).fingerprint(), a);
+}
+
+TEST_F(ModulusImage, NanAndInfiniteVoxelsAreRefusedNamingTheFirst) {
+  // niftilib would read them as 0 HU, the softest tissue, with nothing said.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  NiftiImage image = real_image();
+  image.reals[2 + 3 * (1 + 4 * 1)] = nan;  // (2,1,1)
+  image.reals[0 + 3 * (3 + 4 * 1)] = nan;  // (0,3,1), later in the file
+  const auto path = write(image);
+  EXPECT_EQ(refusal(path), path.string() + ": voxel (2,1,1) is NaN");
+  image = real_image();
+  image.reals[1 + 3 * 2] = inf;  // (1,2,0)
+  EXPECT_EQ(refusal(write(image)), path.string() + ": voxel (1,2,0) is +inf");
+  image.reals[1 + 3 * 2] = -inf;
+  EXPECT_EQ(refusal(write(image)), path.string() + ": voxel (1,2,0) is -inf");
+  // Finite as stored, but past single precision once scaled.
+  image = NiftiImage{3, 3, 3, std::vector<std::int16_t>(27, 10)};
+  image.values[26] = 32767;
+  image.slope = 1e35f;
+  EXPECT_EQ(refusal(write(image)), path.string() +
+                                       ": voxel (2,2,2) = 32767 scaled by scl_slope = 1e+35, "
+                                       "scl_inter = 0 is 3.2767e+39, beyond single precision");
+  image.slope = 1.0f;
+  EXPECT_EQ(refusal(write(image)), "");
+}
+
+TEST_F(ModulusImage, HeaderFieldsAtFaultAreNamed) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<std::pair<std::function<void(NiftiImage&)>, std::string>> cases = {
+      {[](NiftiImage& i) { i.pixdim = Eigen::Vector3f(0, 1, 1); },
+       "NIfTI header pixdim[1] = 0 (voxel size must be finite and > 0)"},
+      {[](NiftiImage& i) { i.pixdim = Eigen::Vector3f(1, -1, 1); },
+       "NIfTI header pixdim[2] = -1 (voxel size must be finite and > 0)"},
+      {[&](NiftiImage& i) { i.pixdim = Eigen::Vector3f(1, 1, nan); },
+       "NIfTI header pixdim[3] = nan (voxel size must be finite and > 0)"},
+      {[](NiftiImage& i) { i.pixdim = Eigen::Vector3f(2000, 1, 1); },
+       "NIfTI header pixdim[1] = 2000 (voxel size must be between 1 nm and 1 m)"},
+      {[](NiftiImage& i) { i.vox_offset = -100; },
+       "NIfTI header vox_offset = -100 (the data must start after the 352-byte header)"},
+      {[](NiftiImage& i) { i.vox_offset = 0; },
+       "NIfTI header vox_offset = 0 (the data must start after the 352-byte header)"},
+      {[](NiftiImage& i) { i.vox_offset = 360.5; },
+       "NIfTI header vox_offset = 360.5 (must be a whole number of bytes)"},
+      {[](NiftiImage& i) {
+         i.version = 2;
+         i.vox_offset = 352;
+       },
+       "NIfTI header vox_offset = 352 (the data must start after the 544-byte header)"},
+      {[&](NiftiImage& i) { i.slope = nan; }, "NIfTI header scl_slope = nan (must be finite)"},
+      {[&](NiftiImage& i) { i.intercept = -inf; },
+       "NIfTI header scl_inter = -inf (must be finite)"},
+      {[&](NiftiImage& i) {
+         i.sform(1, 2) = nan;
+         i.pixdim = Eigen::Vector3f(1, 1, 1);
+       },
+       "NIfTI header srow_y[2] = nan (the sform must be finite)"},
+      {[](NiftiImage& i) { i.sform_code = 9; }, "NIfTI header sform_code = 9 (must be 0 to 5)"},
+      {[](NiftiImage& i) {
+         i.sform.col(0) *= 1e7;
+         i.pixdim = Eigen::Vector3f(1, 1, 1);
+       },
+       "the voxel-to-world transform (sform) steps 10000 m along i (a voxel must be between 1 nm "
+       "and 1 m)"},
+      {[](NiftiImage& i) { i.sform(2, 3) = 1e12; },
+       "the voxel-to-world transform (sform) puts voxel (0,0,0) 1e+09 m from the origin (more "
+       "than 1e6 m)"},
+  };
+  for (const auto& [change, expected] : cases) {
+    NiftiImage image{3, 3, 3, std::vector<std::int16_t>(27, 10)};
+    change(image);
+    const auto path = write(image);
+    EXPECT_EQ(refusal(path), path.string() + ": " + expected);
+    // niftilib would take a bad voxel size as 1 mm where no sform overrides it: refused alike.
+    image.sform_code = 0;
+    if (expected.find("pixdim") != std::string::npos)
+      EXPECT_EQ(refusal(write(image)), path.string() + ": " + expected);
+  }
+}
+
+TEST_F(ModulusImage, DataBeyondTheEndOfTheFileIsRefused) {
+  NiftiImage image{3, 3, 3, std::vector<std::int16_t>(27, 10)};
+  image.vox_offset = 400;
+  const auto path = write(image);
+  EXPECT_EQ(refusal(path), "");
+  std::filesystem::resize_file(path, 400 + 2 * 27 - 1);
+  EXPECT_EQ(refusal(path), path.string() +
+                               ": truncated: NIfTI header vox_offset = 400 and dims 3 x 3 x 3 of "
+                               "INT16 need 454 bytes; the file holds 453");
+  std::filesystem::resize_file(path, 200);
+  EXPECT_EQ(refusal(path), path.string() + ": not a NIfTI-1 or NIfTI-2 image (.nii or .nii.gz)");
+}
+
+TEST_F(ModulusImage, BothByteOrdersAndBothVersionsReadAlike) {
+  // Values a float holds exactly, so that NIfTI-1's single and NIfTI-2's double precision agree.
+  NiftiImage image{5, 4, 3, {}};
+  image.sform.leftCols<3>() = Eigen::Vector3d(0.75, 1.25, 2.5).asDiagonal();
+  image.sform.col(3) << -30.0, 12.5, 7.0;
+  image.slope = 0.5f;
+  image.intercept = -20.0f;
+  for (int v = 0; v < 60; ++v)
+    image.values.push_back(static_cast<std::int16_t>(7 * v - 100));
+  const HuToYoungs table = parse_hu_to_youngs(default_hu_to_youngs, "t");
+  const std::string little_1 = YoungsModulusImage(write(image), table).fingerprint();
+  for (int version : {1, 2})
+    for (bool big_endian : {false, true}) {
+      image.version = version;
+      image.big_endian = big_endian;
+      EXPECT_EQ(YoungsModulusImage(write(image), table).fingerprint(), little_1)
+          << "NIfTI-" << version << (big_endian ? " big" : " little") << "-endian";
+    }
+  image.reals.assign(60, 42.0f);
+  const std::string reals = YoungsModulusImage(write(image), table).fingerprint();
+  image.big_endian = false;
+  EXPECT_EQ(YoungsModulusImage(write(image), table).fingerprint(), reals);
 }
 
 TEST_F(ModulusImage, AFileThatIsNotAnImageIsNamed) {

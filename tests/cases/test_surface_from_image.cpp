@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "msfem/cases/errors.hpp"
@@ -142,6 +143,41 @@ TEST_F(SurfaceFromImage, EmptyWindowGivesTheImagesRange) {
   EXPECT_THROW(surface_from_image(dir_ / "ball.nii", options), InputError);
   EXPECT_THROW(parse_threshold("5:1", "--threshold"), InputError);
   EXPECT_THROW(parse_threshold("x", "--threshold"), InputError);
+}
+
+TEST_F(SurfaceFromImage, NanVoxelsInALabelMapAreRefused) {
+  // A NaN compares unequal to every label and outside every window: it would be background.
+  const NiftiImage labels = ball_image(7, 0, 0, 10.0);
+  NiftiImage image = labels;
+  image.reals.assign(labels.values.begin(), labels.values.end());
+  image.reals[static_cast<std::size_t>(5 + 48 * (6 + 40 * 7))] =
+      std::numeric_limits<float>::quiet_NaN();
+  testing::write_nifti(dir_ / "ball.nii", image);
+  ImageSurfaceOptions options;
+  options.selection.label = 7;
+  try {
+    surface_from_image(dir_ / "ball.nii", options);
+    FAIL() << "a NaN voxel was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir_ / "ball.nii").string() + ": voxel (5,6,7) is NaN");
+  }
+}
+
+TEST_F(SurfaceFromImage, AZeroVoxelSizeIsRefusedNotTakenAsOneMillimetre) {
+  NiftiImage image = ball_image(7, 0, 0, 10.0);
+  image.sform_code = 0;  // the voxel size alone places the voxels
+  image.pixdim = Eigen::Vector3f(1.0f, 0.0f, 1.5f);
+  testing::write_nifti(dir_ / "ball.nii", image);
+  ImageSurfaceOptions options;
+  options.selection.label = 7;
+  try {
+    surface_from_image(dir_ / "ball.nii", options);
+    FAIL() << "pixdim 0 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              (dir_ / "ball.nii").string() +
+                  ": NIfTI header pixdim[2] = 0 (voxel size must be finite and > 0)");
+  }
 }
 
 TEST_F(SurfaceFromImage, NotNiftiAndMissingFilesAreInputErrors) {

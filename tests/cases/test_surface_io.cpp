@@ -359,6 +359,24 @@ TEST_F(SurfaceIo, BadObjLines) {
   expect_read_error(write_file("j.obj", v + "curv 0 1 1 2\n"), {"j.obj:4:", "'curv'"});
 }
 
+TEST_F(SurfaceIo, AbsurdScalesAreRefusedForEveryReader) {
+  // CGAL's predicates overflow on the first (the alpha wrap died with SIGFPE) and divide by zero on
+  // the others; every command reads through here, so none of them gets that far.
+  const std::string faces = "f 1 2 3\nf 1 3 2\n";
+  expect_read_error(write_file("far.obj", "v 0 0 0\nv 1e200 0 0\nv 0 1 0\n" + faces),
+                    {"far.obj: vertex 2 (of 3, in file order) is at (1e+200, 0, 0) m, more than "
+                     "1e6 m from the origin"});
+  expect_read_error(write_file("point.obj", "v 1 2 3\nv 1 2 3\nv 1 2 3\n" + faces),
+                    {"point.obj: the surface spans 0 m (its bounding-box diagonal), less than "
+                     "1e-6 m"});
+  expect_read_error(write_file("tiny.obj", "v 0 0 0\nv 1e-300 0 0\nv 0 1e-300 0\n" + faces),
+                    {"tiny.obj: the surface spans 1.41421e-300 m"});
+  // The bound applies in metres, after the unit: 5e8 mm is 5e5 m.
+  const fs::path mm = write_file("mm.off", "OFF\n3 1 0\n0 0 0\n5e8 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_NO_THROW(read_surface(mm, LengthUnit::millimetre));
+  expect_read_error(mm, {"mm.off: vertex 2", "(5e+08, 0, 0) m"});
+}
+
 TEST_F(SurfaceIo, BadStl) {
   write_surface(file("cube.stl"), cube(), {LengthUnit::metre, true});
   std::string bytes;

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface_generators.hpp"
@@ -152,6 +155,39 @@ TEST(SurfaceRepair, NothingUsableIsAnInputError) {
   RepairReport r;
   EXPECT_THROW(repair_surface(flat, {}, r), InputError);
   EXPECT_THROW(repair_surface(Surface{}, {}, r), InputError);
+}
+
+TEST(SurfaceRepair, AbsurdCoordinatesAndWrapSizesAreRefusedBeforeCgal) {
+  // Each of these died with SIGFPE inside the alpha wrap or refined for hours.
+  RepairReport r;
+  RepairOptions wrap;
+  wrap.always_wrap = true;
+  const Surface far{1e200 * icosphere(1, 1.0).vertices, icosphere(1, 1.0).triangles};
+  try {
+    repair_surface(far, wrap, r);
+    ADD_FAILURE() << "1e200 m accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "vertex 0 is more than 1e6 m from the origin");
+  }
+  const Surface sphere = icosphere(1, 1.0);  // bounding-box diagonal 2 sqrt(3) m
+  const std::vector<std::tuple<double, double, std::string>> sizes = {
+      {1e300, 0.1, "the wrap's alpha 1e+300 m must be between 1/500 and 10 times"},
+      {1e-300, 0.1, "the wrap's alpha 1e-300 m must be between 1/500 and 10 times"},
+      {1e-3, 0.1, "the wrap's alpha 0.001 m must be between 1/500 and 10 times"},
+      {0.5, 1e300, "the wrap's offset 1e+300 m must be between 1e-6 and 1 times"},
+      {0.5, 1e-300, "the wrap's offset 1e-300 m must be between 1e-6 and 1 times"},
+  };
+  for (const auto& [alpha, offset, expected] : sizes) {
+    RepairOptions options = wrap;
+    options.alpha = alpha;
+    options.offset = offset;
+    try {
+      repair_surface(sphere, options, r);
+      ADD_FAILURE() << "alpha " << alpha << ", offset " << offset << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), expected + " the surface's bounding-box diagonal, 3.4641 m");
+    }
+  }
 }
 
 }  // namespace

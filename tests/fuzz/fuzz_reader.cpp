@@ -1,7 +1,8 @@
 // libFuzzer target for one of msfem's input readers, chosen at compile time (MSFEM_FUZZ_OBJ, _STL,
-// _OFF, _PLY, _CASE). A reader may refuse an input only with cases::InputError; anything else (a
-// crash, a hang, a sanitizer report, another exception, or a surface it returns with an index out
-// of range or a non-finite coordinate) is a defect the fuzzer reports.
+// _OFF, _PLY, _CASE, _NIFTI). A reader may refuse an input only with cases::InputError; anything
+// else (a crash, a hang, a sanitizer report, another exception, a surface it returns with an index
+// out of range or a non-finite coordinate, an image with a non-finite voxel or a transform that is
+// not finite and invertible) is a defect the fuzzer reports.
 
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +16,15 @@
 #ifdef MSFEM_FUZZ_CASE
 #include "case_file_text.hpp"
 #endif
+#ifdef MSFEM_FUZZ_NIFTI
+#include <unistd.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <cstdio>
+
+#include "voxel_volume.hpp"
+#endif
 
 namespace {
 
@@ -26,6 +36,35 @@ void check(const Surface& s) {
     for (int k = 0; k < 3; ++k)
       if (s.triangles(t, k) < 0 || s.triangles(t, k) >= s.vertices.rows()) std::abort();
 }
+
+#ifdef MSFEM_FUZZ_NIFTI
+void check(const msfem::cases::detail::VoxelVolume& image) {
+  for (long size : image.grid.size)
+    if (size < 2) std::abort();
+  if (image.values.size() != static_cast<std::size_t>(image.grid.count())) std::abort();
+  for (float v : image.values)
+    if (!std::isfinite(v)) std::abort();
+  if (!image.voxel_to_world.allFinite() || image.voxel_to_world.determinant() == 0) std::abort();
+}
+
+// The reader takes a path (zlib and niftilib open files): the bytes go to a file of this process's
+// own, so that parallel fuzzing jobs do not share one, removed after each read, because rewriting a
+// truncated file makes ext4 flush it to disk on close, a hundredfold slowdown.
+class Written {
+ public:
+  explicit Written(std::string_view bytes) {
+    std::FILE* out = std::fopen(path.c_str(), "wb");
+    if (!out || std::fwrite(bytes.data(), 1, bytes.size(), out) != bytes.size() ||
+        std::fclose(out) != 0)
+      std::abort();
+  }
+  ~Written() { std::remove(path.c_str()); }
+  Written(const Written&) = delete;
+  Written& operator=(const Written&) = delete;
+
+  const std::string path = "/tmp/msfem_fuzz_nifti_" + std::to_string(::getpid()) + ".nii";
+};
+#endif
 
 }  // namespace
 
@@ -46,6 +85,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     static const std::set<std::string> sections = {
         "geometry", "material", "support", "loads", "loads/tool", "loads/patch force", "fem"};
     msfem::cases::checked_case_text("/nonexistent/fuzz.prm", std::string(bytes), sections);
+#elif defined(MSFEM_FUZZ_NIFTI)
+    const Written file(bytes);
+    check(msfem::cases::detail::read_nifti(file.path));
 #endif
   } catch (const msfem::cases::InputError&) {
     // a refused input, named: what a reader must do with bad bytes
