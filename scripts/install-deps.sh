@@ -12,6 +12,7 @@ packages=(
   libnifti2-dev          # msfem surface-from-image: NIfTI-1/2 reader (niftilib, the reference implementation)
   libhdf5-openmpi-dev    # fields.h5 output (the HDF5 deal.II links, so one HDF5 per process)
   nlohmann-json3-dev     # summary.json and every --json output
+  libpugixml-dev         # user networks as VTK XML (.vtu): a small DOM reader; zlib (deal.II's) inflates
   libnlopt-cxx-dev       # msfem calibrate: derivative-free optimiser (BOBYQA) for spring coefficients
   libsuitesparse-dev     # CHOLMOD: spring statics in msfem run/sweep/calibrate
   libopenblas0-serial    # optimised BLAS under CHOLMOD's supernodal kernels (reference BLAS is 2x slower)

@@ -69,6 +69,10 @@ void check_geometry_unit(const GeometryParameters& geometry) {
 }
 
 void check_mass_spring(const MassSpringParameters& ms) {
+  if (ms.variants.empty() && ms.networks.empty())
+    throw InputError(
+        "mass spring/variants is empty and mass spring/networks names none: "
+        "nothing to compare with the FEM");
   const auto& refinement = ms.contact_refinement;
   if (!refinement.enabled && (refinement.radius_m > 0 || refinement.edge_m > 0))
     throw InputError(

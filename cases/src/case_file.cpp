@@ -15,6 +15,7 @@
 
 #include "case_consistency.hpp"
 #include "case_file_text.hpp"
+#include "case_lists.hpp"
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/modulus_image.hpp"
@@ -131,8 +132,13 @@ void declare_loads(ParameterHandler& prm) {
 void declare_mass_spring(ParameterHandler& prm) {
   prm.enter_subsection("mass spring");
   prm.declare_entry("variants", "three_tier, single_layer, tet_edges, skeleton",
-                    Patterns::List(Patterns::Selection(selection_of<Variant>()), 1),
-                    "Mass-spring variants to build and compare with the FEM.");
+                    Patterns::List(Patterns::Selection(selection_of<Variant>()), 0),
+                    "Mass-spring variants to build and compare with the FEM (may be empty when "
+                    "networks are given).");
+  prm.declare_entry("networks", "", Patterns::Anything(),
+                    "A user's own networks, NAME=FILE separated by ';' (.vtu, .vtk, .xs3; "
+                    "relative to the case file), each compared as a variant named NAME "
+                    "(docs/networks.md).");
   prm.declare_entry("stiffness model", "lloyd",
                     Patterns::Selection(selection_of<massspring::TetStiffnessRule>()),
                     "Analytic starting stiffness: Lloyd et al. 2007 or van Gelder 1998.");
@@ -423,19 +429,11 @@ void extract_mass_spring(ParameterHandler& prm, CaseParameters& c) {
   ms.variants.clear();
   for (const auto& name : dealii::Utilities::split_string_list(prm.get("variants")))
     ms.variants.push_back(parse_setting<Variant>(name, "mass spring/variants"));
+  ms.networks = parse_networks(prm.get("networks"));
   ms.stiffness_model = setting<massspring::TetStiffnessRule>(prm, "stiffness model");
   ms.damping_ratio = prm.get_double("damping ratio");
-  for (const auto& entry : dealii::Utilities::split_string_list(prm.get("group scales"))) {
-    const auto colon = entry.find(':');
-    char* end = nullptr;
-    const double factor =
-        colon == std::string::npos ? 0.0 : std::strtod(entry.c_str() + colon + 1, &end);
-    if (colon == std::string::npos || !end || *end != '\0' || !(factor > 0) ||
-        !std::isfinite(factor))
-      throw InputError("mass spring/group scales: '" + entry +
-                       "' is not GROUP:FACTOR with a positive factor");
-    ms.group_scales.emplace_back(entry.substr(0, colon), factor);
-  }
+  ms.group_scales =
+      parse_group_scales(dealii::Utilities::split_string_list(prm.get("group scales")));
   ms.volume_preservation = prm.get_bool("volume preservation");
   prm.enter_subsection("three tier");
   ms.middle_tier_scale = prm.get_double("middle tier scale");
@@ -556,6 +554,13 @@ CaseParameters read_case(const std::filesystem::path& file,
   }
   c.file = file;
   c.name = file.stem().string();
+  for (auto& network : c.mass_spring.networks) {
+    if (network.file.is_relative())
+      network.file = (file.parent_path() / network.file).lexically_normal();
+    if (!std::filesystem::is_regular_file(network.file))
+      throw InputError(file.string() + ": mass spring/networks: " + network.name + "=" +
+                       network.file.string() + ": no such file");
+  }
   // A relative surface path is relative to the case file, so cases run from any folder.
   if (is_image_source(c.geometry.source)) {
     try {

@@ -13,6 +13,7 @@
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/pipeline/fem_error_estimate.hpp"
+#include "msfem/compare/pipeline/fem_references.hpp"
 #include "msfem/compare/pipeline/metrics.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 
@@ -130,10 +131,7 @@ TEST(FemErrorEstimate, LowerDegreeBoundsTheRefinedEstimateFromAbove) {
   const auto mesh = mesh_problem(problem, problem.tools);
   const auto tool = std::optional<ToolPlacement>(problem.tools.front());
   const FemSolution reference = solve_fem(problem, mesh, tool);
-  std::vector<int> compared;
-  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
-  for (std::size_t v = 0; v < prescribed.size(); ++v)
-    if (!prescribed[v]) compared.push_back(int(v));
+  const std::vector<int> compared = unprescribed_vertices(problem, tool);
   auto estimate = [&](Method method) {
     Problem p = problem;
     p.parameters.fem.error_estimate = method;
@@ -161,10 +159,7 @@ TEST(FemErrorEstimate, DISABLED_SphereIndentEstimateBracketsTheTruth) {
   const auto mesh = mesh_problem(problem);
   const auto tool = std::optional<ToolPlacement>(problem.tools.front());
   const FemSolution coarse = solve_fem(problem, mesh, tool);
-  std::vector<int> compared;
-  const std::vector<bool> prescribed = prescribed_surface_vertices(problem, tool);
-  for (std::size_t v = 0; v < prescribed.size(); ++v)
-    if (!prescribed[v]) compared.push_back(int(v));
+  const std::vector<int> compared = unprescribed_vertices(problem, tool);
   const auto plan = plan_error_estimate(problem, mesh, 4, 1);
   ASSERT_EQ(plan.method, Method::refine);
   const FemErrorEstimate estimate =

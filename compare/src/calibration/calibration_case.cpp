@@ -17,8 +17,13 @@ namespace msfem::compare {
 namespace {
 
 cases::Variant resolve_variant(const cases::CaseParameters& p, const CalibrationRequest& request) {
-  const cases::Variant variant =
-      request.variant.value_or(p.calibration.variant.value_or(p.mass_spring.variants.front()));
+  if (p.mass_spring.variants.empty() && !request.variant && !p.calibration.variant)
+    throw cases::InputError(p.file.string() +
+                            ": msfem calibrate fits a built-in variant, and mass spring/variants "
+                            "is empty (a network from mass spring/networks is not fitted yet)");
+  const cases::Variant variant = request.variant         ? *request.variant
+                                 : p.calibration.variant ? *p.calibration.variant
+                                                         : p.mass_spring.variants.front();
   const auto& defined = p.mass_spring.variants;
   if (std::find(defined.begin(), defined.end(), variant) == defined.end()) {
     std::string list;

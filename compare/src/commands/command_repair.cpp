@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <optional>
 
 #include "msfem/cases/errors.hpp"
@@ -15,20 +16,10 @@
 namespace msfem::compare {
 namespace {
 
-// A length option in the file's unit, returned in metres.
+// A length option in the file's unit, returned in metres (repair bounds it against the surface).
 std::optional<double> length_option(const Options& opt, const std::string& key, double metres) {
-  const auto v = opt.value(key);
-  if (!v) return std::nullopt;
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(*v, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != v->size() || !std::isfinite(value) || value <= 0)
-    throw std::invalid_argument("option --" + key + ": '" + *v + "' is not a positive length");
-  return value * metres;
+  if (!opt.value(key)) return std::nullopt;
+  return opt.number(key, 0.0, 0.0, std::numeric_limits<double>::max()) * metres;
 }
 
 void print_report(const std::string& out, const cases::RepairReport& r, const char* unit,

@@ -49,6 +49,11 @@ const std::vector<CommandEntry>& commands() {
        "          [--no-cache] [--quiet]\n"
        "      fit spring-group stiffness to the FEM on training loads (DX,DY,DZ@DEPTH;...), check\n"
        "      on held-out loads; calibration.json, report.md, calibrated.prm"},
+      {"export-network", export_network_command,
+       "export-network CASE.prm OUTDIR [--set K=V]...\n"
+       "      every variant of the case as a network file a simulator loads: NAME.vtu (springs,\n"
+       "      groups, masses, fixed nodes, anchors, volume elements) and, where Xsp holds the\n"
+       "      whole model, NAME.xs3; each runs again as mass spring/networks = NAME=FILE"},
       {"params", params_command, "params\n      print the whole case-file language"},
       {"mesh-info", mesh_info_command,
        "mesh-info FILE [--unit m|cm|mm] [--json] [--no-self-intersections]\n"

@@ -160,7 +160,6 @@ ToolLoadVariant compare_at_load(const Problem& problem, const BuiltVariant& buil
   const FemSolution& fem = load.fem;
   const std::optional<ToolPlacement>& tool = load.tool;
   ToolLoadVariant o;
-  o.kind = built.kind;
   o.name = built.name;
   o.errors = zoned_displacement_error(s.surface_displacement, fem.surface_displacement,
                                       problem.surface.vertices, load.compared_vertices,
@@ -219,7 +218,7 @@ void warn_at_load(const CaseRun& run, long long tetrahedra, std::size_t load, Va
 
 VariantResult variant_header(const BuiltVariant& built) {
   VariantResult r;
-  r.kind = built.kind;
+  r.spec = built.spec;
   r.name = built.name;
   r.nodes = built.model->num_nodes();
   r.springs = built.model->network().num_springs();
@@ -258,7 +257,7 @@ void press_loads(const CaseRun& run, BuiltVariant& built, const std::vector<doub
   if (n - first == 1 || std::thread::hardware_concurrency() < 2) {
     work(built, first, 1);
   } else {
-    BuiltVariant copy = build_variant(built.kind, run.problem, run.mesh, run.loads.front().tool);
+    BuiltVariant copy = build_variant(built.spec, run.problem, run.mesh, run.loads.front().tool);
     std::thread second([&] { work(copy, first + 1, 2); });
     work(built, first, 2);
     second.join();
@@ -286,10 +285,10 @@ VariantResult run_variant(const CaseRun& run, BuiltVariant& built, const std::ve
 void run_variants(CaseRun& run, const std::vector<double>& path, const RunSettings& settings,
                   const Progress& progress) {
   const auto start = Clock::now();
-  const auto& variants = run.problem.parameters.mass_spring.variants;
+  const std::vector<VariantSpec> variants = variant_specs(run.problem.parameters);
   const int total = static_cast<int>(variants.size());
   for (int i = 0; i < total; ++i) {
-    const std::string name = cases::name_of(variants[i]);
+    const std::string& name = variants[i].name;
     BuiltVariant built = build_variant(variants[i], run.problem, run.mesh, run.loads.front().tool);
     try {
       VariantResult r = run_variant(run, built, path, settings);

@@ -20,9 +20,11 @@ namespace {
 
 // The nodes a variant will have, before it is built: the statics' cost grows with them (sparse
 // Cholesky, about the 1.5th power in a volume).
-double estimated_nodes(const CaseRun& run, cases::Variant kind) {
+double estimated_nodes(const CaseRun& run, const VariantSpec& spec) {
   const auto surface = static_cast<double>(run.problem.surface.num_vertices());
-  switch (kind) {
+  // A user's network is not read before it is built: as many nodes as the three tiers, most.
+  if (!spec.builtin) return 3.0 * surface;
+  switch (*spec.builtin) {
     case cases::Variant::three_tier:
       return 3.0 * surface;
     case cases::Variant::tet_edges:
@@ -37,11 +39,11 @@ double estimated_nodes(const CaseRun& run, cases::Variant kind) {
 
 // Whether this rank presses variant v at load k: mine[v][k], dealt by cost, alike on every rank.
 std::vector<std::vector<bool>> this_ranks_items(const CaseRun& run) {
-  const auto& variants = run.problem.parameters.mass_spring.variants;
+  const std::vector<VariantSpec> variants = variant_specs(run.problem.parameters);
   std::vector<double> cost;
-  for (const cases::Variant kind : variants)
+  for (const VariantSpec& spec : variants)
     for (std::size_t k = 0; k < run.loads.size(); ++k)
-      cost.push_back(std::pow(estimated_nodes(run, kind), 1.5));
+      cost.push_back(std::pow(estimated_nodes(run, spec), 1.5));
   const std::vector<int> owner = ranks::deal(cost);
   std::vector<std::vector<bool>> mine(variants.size(), std::vector<bool>(run.loads.size()));
   for (std::size_t v = 0; v < variants.size(); ++v)
@@ -59,9 +61,9 @@ struct Pending {
 // The built variant is kept where it is to be timed.
 Pending press_share(const CaseRun& run, int v, const std::vector<bool>& mine,
                     const std::vector<double>& path, bool timed) {
-  const cases::Variant kind = run.problem.parameters.mass_spring.variants[v];
+  const VariantSpec spec = variant_specs(run.problem.parameters).at(std::size_t(v));
   Pending p;
-  p.built = build_variant(kind, run.problem, run.mesh, run.loads.front().tool);
+  p.built = build_variant(spec, run.problem, run.mesh, run.loads.front().tool);
   VariantShare& s = p.share;
   s.variant = v;
   s.result = variant_header(*p.built);
@@ -107,7 +109,7 @@ std::vector<VariantShare> this_ranks_shares(const CaseRun& run, const std::vecto
                                             std::exception_ptr& error) {
   std::vector<Pending> pending;
   const auto start = Clock::now();
-  const auto& variants = run.problem.parameters.mass_spring.variants;
+  const std::vector<VariantSpec> variants = variant_specs(run.problem.parameters);
   const int total = static_cast<int>(variants.size());
   const std::vector<std::vector<bool>> mine = this_ranks_items(run);
   try {
@@ -115,7 +117,7 @@ std::vector<VariantShare> this_ranks_shares(const CaseRun& run, const std::vecto
       const std::vector<bool>& loads = mine[static_cast<std::size_t>(v)];
       if (std::find(loads.begin(), loads.end(), true) != loads.end())
         pending.push_back(press_share(run, v, loads, path, settings.time_dynamics));
-      progress.advance("variant " + cases::name_of(variants[v]) + " (this rank's loads)", v + 1,
+      progress.advance("variant " + variants[std::size_t(v)].name + " (this rank's loads)", v + 1,
                        total, seconds_since(start));
     }
   } catch (...) {
@@ -184,12 +186,12 @@ void run_variants_across_ranks(CaseRun& run, const std::vector<double>& path,
   ranks::agree([&] {
     if (error) std::rethrow_exception(error);
   });
-  const auto& variants = run.problem.parameters.mass_spring.variants;
-  Assembly all(variants.size(), run.loads.size());
+  const std::size_t variants = variant_specs(run.problem.parameters).size();
+  Assembly all(variants, run.loads.size());
   for (const std::string& bytes : ranks::gather_on_all(to_bytes(std::move(own))))
     for (VariantShare& share : shares_from_bytes(bytes))
       all.add(share);
-  for (std::size_t v = 0; v < variants.size(); ++v) {
+  for (std::size_t v = 0; v < variants; ++v) {
     VariantResult& r = all.results[v];
     if (all.failure_order[v] >= 0) {
       run.failed_variants.emplace_back(r.name, all.failure[v]);

@@ -224,7 +224,7 @@ std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters
       const VariantResult& v = run.variants[items[j].first];
       if (!built || built->first != items[j].first)
         built.emplace(items[j].first,
-                      build_variant(v.kind, run.problem, run.mesh, run.loads.front().tool));
+                      build_variant(v.spec, run.problem, run.mesh, run.loads.front().tool));
       points[j] = timed_point(run, v, built->second, items[j].second, resolution);
     }
   });

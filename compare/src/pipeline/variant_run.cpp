@@ -135,9 +135,9 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
   for (const auto& [group, factor] : p.mass_spring.group_scales)
     if (group == volume_group) modulus *= factor;
   const auto& rest = model.network().rest_positions;
-  if (!has_volume_elements(variant.kind)) return;
+  if (!variant.spec.builtin || !has_volume_elements(*variant.spec.builtin)) return;
   ms::VolumeElements elements;
-  if (variant.kind == cases::Variant::three_tier)
+  if (variant.spec.builtin == cases::Variant::three_tier)
     elements = ms::tier_prisms(rest, problem.surface.triangles,
                                static_cast<int>(problem.surface.num_vertices()), 3, modulus);
   else
@@ -183,6 +183,16 @@ void check_group_names(const cases::CaseParameters& p) {
     const std::vector<std::string> of_variant = spring_groups_of(v, p);
     groups.insert(of_variant.begin(), of_variant.end());
   }
+  if (!p.mass_spring.group_scales.empty())
+    for (const auto& network : p.mass_spring.networks) {
+      try {
+        const std::vector<std::string> of_network = network_groups(network.file);
+        groups.insert(of_network.begin(), of_network.end());
+      } catch (const cases::InputError& e) {
+        throw cases::InputError(p.file.string() + ": mass spring/networks: " + network.name + "=" +
+                                network.file.string() + ": " + e.what());
+      }
+    }
   for (const auto& [group, factor] : p.mass_spring.group_scales)
     if (!groups.count(group)) {
       std::string list;
@@ -196,6 +206,7 @@ void check_group_names(const cases::CaseParameters& p) {
 }
 
 void check_variants_fit(const Problem& problem) {
+  check_networks_fit(problem);
   const auto& p = problem.parameters;
   const auto& variants = p.mass_spring.variants;
   const int n = static_cast<int>(problem.surface.num_vertices());
@@ -255,45 +266,55 @@ std::optional<int> inverted_tetrahedra(const BuiltVariant& variant, const Eigen:
   return inverted;
 }
 
-BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
+namespace {
+
+// A built-in variant's network from the case: its builder, E (the case's or the CT's field), the
+// shared supports, the case's group scales and volume preservation.
+void build_builtin(BuiltVariant& variant, cases::Variant kind, const Problem& problem,
+                   const fem_reference::VolumeMesh& mesh) {
+  const auto& p = problem.parameters;
+  ms::SpringNetwork network = build_network(kind, problem, mesh);
+  variant.youngs_modulus_range.include(p.material.youngs_modulus_pa);
+  if (problem.youngs_modulus_image)
+    variant.youngs_modulus_range = ms::apply_modulus_field(network, youngs_modulus_field(problem),
+                                                           p.material.youngs_modulus_pa);
+  if (kind == cases::Variant::tet_edges) variant.tetrahedra = mesh.tetrahedra;
+  if (problem.local_refinement) {
+    // three_tier copies the surface into its two inner tiers.
+    const int added = problem.local_refinement->added_vertices;
+    variant.refinement_added_nodes = kind == cases::Variant::three_tier ? 3 * added : added;
+  }
+  variant.warnings = network.warnings;
+  variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
+  ms::MassSpringModel& model = *variant.model;
+  const auto& rest = model.network().rest_positions;
+  for (int node = 0; node < model.num_nodes(); ++node)
+    if (problem.fixed_region(rest.row(node).transpose())) model.fix_node(node);
+  scale_groups(model, p);
+  if (p.mass_spring.volume_preservation) set_volume_preservation(variant, problem);
+  model.set_damping(ms::damping_for_ratio(model.network(), p.mass_spring.damping_ratio));
+}
+
+}  // namespace
+
+BuiltVariant build_variant(const VariantSpec& spec, const Problem& problem,
                            const fem_reference::VolumeMesh& mesh,
                            const std::optional<ToolPlacement>& tool) {
   const auto& p = problem.parameters;
   BuiltVariant variant;
-  variant.kind = kind;
-  variant.name = cases::name_of(kind);
+  variant.spec = spec;
+  variant.name = spec.name;
   variant.case_surface_vertices = problem.surface.num_vertices();
   try {
-    ms::SpringNetwork network = build_network(kind, problem, mesh);
-    variant.youngs_modulus_range.include(p.material.youngs_modulus_pa);
-    if (problem.youngs_modulus_image)
-      variant.youngs_modulus_range = ms::apply_modulus_field(network, youngs_modulus_field(problem),
-                                                             p.material.youngs_modulus_pa);
-    if (kind == cases::Variant::tet_edges) variant.tetrahedra = mesh.tetrahedra;
-    if (problem.local_refinement) {
-      // three_tier copies the surface into its two inner tiers.
-      const int added = problem.local_refinement->added_vertices;
-      variant.refinement_added_nodes = kind == cases::Variant::three_tier ? 3 * added : added;
-    }
-    variant.warnings = network.warnings;
-    variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
+    if (spec.builtin)
+      build_builtin(variant, *spec.builtin, problem, mesh);
+    else
+      build_network_variant(variant, problem);
     ms::MassSpringModel& model = *variant.model;
-    const auto& rest = model.network().rest_positions;
-    for (int node = 0; node < model.num_nodes(); ++node)
-      if (problem.fixed_region(rest.row(node).transpose())) model.fix_node(node);
-    for (const auto& [group, factor] : p.mass_spring.group_scales) {
-      if (std::find(model.network().spring_group_names.begin(),
-                    model.network().spring_group_names.end(),
-                    group) == model.network().spring_group_names.end())
-        continue;  // a group of another variant
-      model.scale_group_stiffness(group, factor);
-    }
-    if (p.mass_spring.volume_preservation) set_volume_preservation(variant, problem);
     if (model.constrained_nodes().empty() && model.network().num_anchors() == 0)
       throw cases::InputError(p.file.string() + ": variant " + variant.name +
                               ": no node lies in the fixed region and nothing anchors it, so it "
                               "would float away (adjust the support or the variant's geometry)");
-    model.set_damping(ms::damping_for_ratio(model.network(), p.mass_spring.damping_ratio));
     model.set_gravity(p.loads.gravity_m_per_s2);
     apply_patch_force(model, problem);
     if (tool) set_tool_depth(variant, *tool);
@@ -301,6 +322,19 @@ BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
     throw cases::InputError(p.file.string() + ": variant " + variant.name + ": " + e.what());
   }
   return variant;
+}
+
+BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
+                           const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool) {
+  return build_variant(builtin_spec(kind), problem, mesh, tool);
+}
+
+void scale_groups(massspring::MassSpringModel& model, const cases::CaseParameters& p) {
+  const auto& names = model.network().spring_group_names;
+  for (const auto& [group, factor] : p.mass_spring.group_scales)
+    if (std::find(names.begin(), names.end(), group) != names.end())
+      model.scale_group_stiffness(group, factor);  // else a group of another variant
 }
 
 StaticSolution solve_variant_static(const BuiltVariant& variant, const Eigen::VectorXd& start) {

@@ -134,9 +134,11 @@ template <typename Io, typename S>
 void share_fields(Io& io, S& s) {
   io.io(s.variant), io.io(s.timed), io.io(s.tetrahedra), io.io(s.failure_order), io.io(s.failure);
   VariantResult& r = s.result;
-  int kind = static_cast<int>(r.kind);
-  io.io(kind);
-  r.kind = static_cast<cases::Variant>(kind);
+  int builtin = r.spec.builtin ? static_cast<int>(*r.spec.builtin) : -1;
+  std::string network = r.spec.network.string();
+  io.io(builtin), io.io(r.spec.name), io.io(network);
+  if (builtin >= 0) r.spec.builtin = static_cast<cases::Variant>(builtin);
+  r.spec.network = network;
   io.io(r.name), io.io(r.nodes), io.io(r.springs), io.io(r.refinement_added_nodes);
   timing_fields(io, r.timing);
   std::string parameters = r.parameters.dump();
@@ -153,7 +155,6 @@ void share_fields(Io& io, S& s) {
   r.loads.resize(static_cast<std::size_t>(n));
   for (std::size_t i = 0; i < s.load_indices.size(); ++i) {
     io.io(s.load_indices[i]);
-    r.loads[i].kind = r.kind;
     r.loads[i].name = r.name;
     load_fields(io, r.loads[i]);
   }

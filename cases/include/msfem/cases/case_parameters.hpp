@@ -126,6 +126,13 @@ struct MassSpringParameters {
     double edge_m = 0.0;    ///< longest edge there; 0: the tool radius / 3
   };
   ContactRefinement contact_refinement;
+  /// A user's own networks (`mass spring/networks = NAME=FILE; ...`, paths relative to the case
+  /// file), each compared as a variant named NAME beside the built-in ones (docs/networks.md).
+  struct Network {
+    std::string name;
+    std::filesystem::path file;
+  };
+  std::vector<Network> networks;
 };
 
 struct FemParameters {

@@ -21,6 +21,7 @@ int sweep_command(const Arguments& args);    // msfem sweep CASE.prm [--resoluti
 int bench_command(const Arguments& args);    // msfem bench massspring|fem [--json]
 int verify_command(const Arguments& args);   // msfem verify [--json]
 int regress_command(const Arguments& args);  // msfem regress [--baselines DIR] [CASE...] [--update]
+int export_network_command(const Arguments& args);  // msfem export-network CASE.prm OUTDIR
 int calibrate_command(const Arguments& args);  // msfem calibrate CASE.prm [--variant V] [--fit G]
 
 }  // namespace msfem::compare

@@ -25,8 +25,7 @@ namespace msfem::compare {
 /// One variant pressed at one load of the run (a tool position of the case, at the case's depth,
 /// reached along the loading path; or the case's gravity or patch force).
 struct ToolLoadVariant {
-  cases::Variant kind = cases::Variant::three_tier;
-  std::string name;  ///< kind's name
+  std::string name;  ///< the variant's
   ZonedErrorMetrics errors;
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
   double reaction_force_rel_error = 0.0;
@@ -46,8 +45,8 @@ struct ToolLoadVariant {
 
 /// One variant over the run: what it is, how fast it runs, and its result at every load.
 struct VariantResult {
-  cases::Variant kind = cases::Variant::three_tier;
-  std::string name;  ///< kind's name
+  VariantSpec spec;
+  std::string name;  ///< spec's name
   int nodes = 0, springs = 0;
   std::optional<int> refinement_added_nodes;  ///< BuiltVariant's
   Timing timing;                              ///< from its equilibrium at the first load

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "msfem/compare/pipeline/problem.hpp"
+#include "msfem/compare/pipeline/variant_spec.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/modulus_field.hpp"
@@ -44,8 +45,8 @@ inline constexpr const char* volume_hint =
 /// patch the FEM prescribes. `mesh` is the FEM's volume mesh (tet_edges springs its edges). Throws
 /// cases::InputError naming the case key for a bad group name or a variant without supports.
 struct BuiltVariant {
-  cases::Variant kind = cases::Variant::three_tier;
-  std::string name;  ///< kind's name
+  VariantSpec spec;
+  std::string name;  ///< spec's name
   std::unique_ptr<massspring::MassSpringModel> model;
   std::vector<int> tool_patch;  ///< nodes the tool prescribes (the bonded patch)
   /// The frictionless tool's pressure penalty (Pa/m), chosen at its first depth and kept.
@@ -65,9 +66,30 @@ struct BuiltVariant {
   massspring::ModulusRange youngs_modulus_range;
   std::vector<std::string> warnings;
 };
+BuiltVariant build_variant(const VariantSpec& spec, const Problem& problem,
+                           const fem_reference::VolumeMesh& mesh,
+                           const std::optional<ToolPlacement>& tool);
 BuiltVariant build_variant(cases::Variant kind, const Problem& problem,
                            const fem_reference::VolumeMesh& mesh,
                            const std::optional<ToolPlacement>& tool);
+
+/// A user's network (spec.network) as the variant's model: read from its file, its surface nodes
+/// matched to the case's surface vertices, the arrays it leaves out taken from the case (masses
+/// from the case's density, fixed nodes from the support region, dampers from the damping ratio),
+/// the case's group scales applied (network_variant.cpp, docs/networks.md).
+void build_network_variant(BuiltVariant& variant, const Problem& problem);
+
+/// Reads every network of the case and matches its nodes to the surface, so that a bad file or a
+/// network of another geometry is refused (cases::InputError) before the FEM is solved.
+void check_networks_fit(const Problem& problem);
+
+/// The coefficient groups of a network file: its spring groups, and `volume` where it has volume
+/// elements.
+std::vector<std::string> network_groups(const std::filesystem::path& file);
+
+/// Scales the model's spring groups that `mass spring/group scales` names (a group the model does
+/// not have belongs to another variant).
+void scale_groups(massspring::MassSpringModel& model, const cases::CaseParameters& p);
 
 /// Moves the tool of an already built variant to another depth (the force-depth curve).
 void set_tool_depth(BuiltVariant& variant, const ToolPlacement& tool);

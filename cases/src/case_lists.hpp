@@ -1,0 +1,19 @@
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "msfem/cases/case_parameters.hpp"
+
+namespace msfem::cases {
+
+/// `mass spring/group scales`: GROUP:FACTOR entries, each factor finite and > 0.
+std::vector<std::pair<std::string, double>> parse_group_scales(
+    const std::vector<std::string>& list);
+
+/// `mass spring/networks`: NAME=FILE entries separated by ';'. A name is letters, digits and '_',
+/// not a built-in variant's and not repeated; paths stay as written (read_case resolves them).
+std::vector<MassSpringParameters::Network> parse_networks(const std::string& text);
+
+}  // namespace msfem::cases
