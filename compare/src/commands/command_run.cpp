@@ -50,7 +50,8 @@ int run_command(const Arguments& args) {
     if (!work_dir) return;
     for (const auto& v : run.variants)
       for (const auto& w : v.warnings)
-        if (w.find(buckling_warning_start) != std::string::npos)
+        if (w.find(buckling_warning_start) != std::string::npos ||
+            w.find(lost_tool_warning_start) != std::string::npos)
           buckled.push_back(v.name + ": " + w);
     write_run_outputs(run, *work_dir);
     if (opt.flag("json")) {

@@ -118,7 +118,7 @@ void load_fields(Io& io, L& o) {  // ToolLoadVariant (kind and name come from th
   io.io(o.tool_force), io.io(o.reaction_force_rel_error), io.io(o.volume_change);
   io.io(o.inverted_elements);
   curve_fields(io, o.force_depth);
-  io.io(o.force_depth_monotone), io.io(o.patch_mean_displacement);
+  io.io(o.force_depth_monotone), io.io(o.lost_tool), io.io(o.patch_mean_displacement);
   io.io(o.patch_displacement_rel_error), io.io(o.newton_iterations);
   io.io(o.equilibrium), io.io(o.surface_displacement), io.io(o.error);
 }

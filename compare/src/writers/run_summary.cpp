@@ -96,6 +96,7 @@ nlohmann::json load_json(const CaseRun& run, std::size_t load, const ToolLoadVar
           {"volume_change", o.volume_change},
           {"inverted_elements", json_or_null(o.inverted_elements)},
           {"force_depth_monotone", json_or_null(o.force_depth_monotone)},
+          {"lost_tool", o.lost_tool},
           {"force_depth_exponent",
            json_or_null(force_depth_exponent(o.force_depth, run.loads[load].tool))},
           {"force_depth", curve_json(o.force_depth)}};
@@ -248,6 +249,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"newton_iterations", first.newton_iterations},
       {"force_depth", fd},
       {"force_depth_monotone", json_or_null(first.force_depth_monotone)},
+      {"lost_tool", first.lost_tool},
       {"force_depth_exponent",
        json_or_null(force_depth_exponent(first.force_depth, run.loads.front().tool))},
       {"inverted_elements", json_or_null(first.inverted_elements)},
@@ -392,7 +394,10 @@ std::string variant_table(const CaseRun& run) {
     const ToolLoadVariant& own = v.loads.front();
     const std::vector<std::string> unresolved = unresolved_metrics(run, own, 0);
     std::string force_error = "-";
-    if (tool) {
+    if (tool && own.lost_tool) {
+      std::snprintf(force, sizeof force, "lost");
+      force_error = "lost";
+    } else if (tool) {
       std::snprintf(force, sizeof force, "%.4g", own.tool_force.norm());
       force_error = error_cell(own.reaction_force_rel_error,
                                contains(unresolved, "reaction_force_rel_error"));

@@ -33,6 +33,9 @@ struct ToolLoadVariant {
   std::optional<int> inverted_elements;
   std::vector<ForceDepthPoint> force_depth;  ///< every step of its loading path
   std::optional<bool> force_depth_monotone;  ///< along its loading path
+  /// No force on the tool where the FEM pushes back: the surface gave way or slid off the sphere,
+  /// so the force columns are no answer (marked "lost", warned about).
+  bool lost_tool = false;
   /// With a patch force: the patch's mean displacement (what a force-controlled load measures)
   /// and its error against the FEM's, |ū − ū_FEM| / |ū_FEM|.
   std::optional<Eigen::Vector3d> patch_mean_displacement;
@@ -143,5 +146,7 @@ BucklingOnset buckling_onset(std::vector<ForceDepthPoint> curve, const ToolPlace
 inline constexpr double lateral_fraction_margin = 0.25;
 /// Every buckling warning starts so (msfem run repeats them on stderr).
 inline constexpr const char* buckling_warning_start = "buckles under the tool";
+/// The warning of a variant that ends a load with no force where the FEM pushes back.
+inline constexpr const char* lost_tool_warning_start = "loses the tool";
 
 }  // namespace msfem::compare
