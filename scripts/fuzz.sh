@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 CC=clang CXX=clang++ cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build-fuzz -j "${MSFEM_JOBS:-2}"
-for format in obj stl off ply case nifti; do
+for format in obj stl off ply case nifti vtu vtk xsp; do
   corpus=build-fuzz/corpus/$format
   mkdir -p "$corpus"
   if [ "$format" = case ]; then
@@ -21,6 +21,10 @@ for format in obj stl off ply case nifti; do
     for seed in "$corpus"/v1_le_int16.nii "$corpus"/v2_be_float32.nii; do
       gzip -c "$seed" >"$seed.gz"
     done
+  elif [ "$format" = vtu ] || [ "$format" = vtk ] || [ "$format" = xsp ]; then
+    # A small network in each format, written by msfem's own writer (and by hand for legacy VTK).
+    build-fuzz/network_seeds build-fuzz/corpus/networks >/dev/null
+    cp build-fuzz/corpus/networks/*."${format/xsp/xs3}" "$corpus"/
   else
     # Small seeds only: libFuzzer mutates them, and -max_len caps what it grows them to.
     find cases/data tests -name "*.$format" -size -200k -exec cp {} "$corpus"/ \; 2>/dev/null || true

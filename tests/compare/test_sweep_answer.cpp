@@ -80,5 +80,28 @@ TEST(SweepAnswer, ObservedOrderPerVariantAndTheVariantsThatDoNotConverge) {
   EXPECT_NE(section.find("**Not converging: bad**"), std::string::npos) << section;
 }
 
+// A configuration the reference does not resolve (its error within 3x of the FEM's own) is named
+// only where no resolved one meets the budget, and then its row says so in words.
+TEST(SweepAnswer, AResolvedConfigurationIsPreferredAndAnUnresolvedOneIsSaidToBe) {
+  SweepPoint unresolved = point("coarse", 1e-4, 50000, 0.35);
+  unresolved.not_resolved_by_reference = {"rel_l2_error"};
+  const SweepPoint resolved = point("fine", 1e-4, 50000, 0.50);
+  const std::string answer = sweep_answer({unresolved, resolved}, std::nullopt);
+  const auto at = answer.find("| least error, 1 kHz");
+  ASSERT_NE(at, std::string::npos) << answer;
+  const std::string row = answer.substr(at, answer.find('\n', at) - at);
+  EXPECT_NE(row.find("| fine, "), std::string::npos) << row;
+  EXPECT_EQ(row.find("not resolved"), std::string::npos) << row;
+  const std::string alone = sweep_answer({unresolved}, std::nullopt);
+  const auto only = alone.find("| least error, 1 kHz");
+  ASSERT_NE(only, std::string::npos) << alone;
+  const std::string named = alone.substr(only, alone.find('\n', only) - only);
+  EXPECT_NE(named.find("| coarse, "), std::string::npos) << named;
+  EXPECT_NE(named.find("**not resolved by this reference**"), std::string::npos) << named;
+  // ‡ on the metric the reference does not resolve, not on the other.
+  EXPECT_NE(named.find("0.3500 ‡"), std::string::npos) << named;
+  EXPECT_EQ(named.find("0.1750 ‡"), std::string::npos) << named;
+}
+
 }  // namespace
 }  // namespace msfem::compare

@@ -13,6 +13,9 @@
 
 #include "msfem/cases/errors.hpp"
 #include "surface_io_detail.hpp"
+#ifdef MSFEM_FUZZ_NETWORK
+#include "msfem/cases/network_file.hpp"
+#endif
 #ifdef MSFEM_FUZZ_CASE
 #include "case_file_text.hpp"
 #endif
@@ -88,6 +91,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 #elif defined(MSFEM_FUZZ_NIFTI)
     const Written file(bytes);
     check(msfem::cases::detail::read_nifti(file.path));
+#elif defined(MSFEM_FUZZ_NETWORK)
+    // A network that is read is valid: every id in range, every coefficient finite.
+    const auto n = msfem::cases::read_network_bytes("fuzz." MSFEM_FUZZ_NETWORK, std::string(bytes));
+    if (!n.points.allFinite() || !n.stiffness.allFinite()) std::abort();
+    for (Eigen::Index s = 0; s < n.springs.rows(); ++s)
+      for (int k = 0; k < 2; ++k)
+        if (n.springs(s, k) < 0 || n.springs(s, k) >= n.points.rows()) std::abort();
 #endif
   } catch (const msfem::cases::InputError&) {
     // a refused input, named: what a reader must do with bad bytes
