@@ -1,6 +1,6 @@
 // Seeds for the network readers' fuzz targets: one small network (four points, six springs in two
-// groups, a surface triangle, a tetrahedron, masses, fixed flags, anchors) as .vtu and .xs3 by
-// msfem's own writer, and as a hand-written legacy .vtk.
+// groups, masses, fixed flags) as .xs3, with a surface triangle, a tetrahedron and anchors as .vtu,
+// both by msfem's own writer, and a hand-written legacy .vtk.
 //   network_seeds DIR
 #include <cstdio>
 #include <filesystem>
@@ -28,14 +28,14 @@ int main(int argc, char** argv) {
   n.group_names = {"edges", "diagonals"};
   n.mass = Eigen::VectorXd::Constant(4, 0.001);
   n.fixed = std::vector<bool>{true, false, false, false};
-  n.anchor_stiffness = Eigen::VectorXd::Constant(4, 1.0);
   std::ofstream(dir / "seed_points.vtk")
       << "# vtk DataFile Version 3.0\nseed\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n"
          "0 0 0 0.01 0 0 0 0.01 0 0 0 0.01\nCELLS 4 14\n2 0 1\n2 0 2\n2 1 2\n3 0 1 2\n"
          "CELL_TYPES 4\n3 3 3 5\nCELL_DATA 4\nSCALARS stiffness double 1\nLOOKUP_TABLE default\n"
          "10 20 30 0\nPOINT_DATA 4\nSCALARS mass double 1\nLOOKUP_TABLE default\n"
          "0.001 0.001 0.001 0.001\n";
-  msfem::cases::write_network(dir / "seed.xs3", n);
+  msfem::cases::write_network(dir / "seed.xs3", n);  // Xsp: springs, masses, fixed flags only
+  n.anchor_stiffness = Eigen::VectorXd::Constant(4, 1.0);
   n.triangles.resize(1, 3);
   n.triangles << 1, 2, 3;
   n.tetrahedra.resize(1, 4);
