@@ -195,24 +195,7 @@ detail::ReadNetwork read_checked(const fs::path& file, std::string_view bytes) {
 void put_on_disk(const fs::path& file, const std::string& bytes) {
   fs::path temporary = file;
   temporary += ".tmp" + std::to_string(::getpid());
-  std::FILE* out = std::fopen(temporary.c_str(), "wb");
-  if (!out) detail::fail(file, std::string("cannot write: ") + std::strerror(errno));
-  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
-  const int write_errno = errno;
-  const bool closed = std::fclose(out) == 0;
-  const int close_errno = errno;
-  std::error_code ignored;
-  if (!written || !closed) {
-    fs::remove(temporary, ignored);
-    detail::fail(
-        file, std::string("cannot write: ") + std::strerror(!written ? write_errno : close_errno));
-  }
-  std::error_code renamed;
-  fs::rename(temporary, file, renamed);
-  if (renamed) {
-    fs::remove(temporary, ignored);
-    detail::fail(file, "cannot write: " + renamed.message());
-  }
+  detail::put_on_disk(file, temporary, bytes);
 }
 
 }  // namespace

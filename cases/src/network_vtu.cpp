@@ -294,18 +294,7 @@ void split_appended(const fs::path& file, std::string_view bytes, VtuDocument& o
     out.same_as_file = bytes.size();
     return;
   }
-  std::size_t tag_end = open;
-  char quote = 0;
-  for (; tag_end < bytes.size(); ++tag_end) {
-    const char c = bytes[tag_end];
-    if (quote) {
-      if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '>') {
-      break;
-    }
-  }
+  const std::size_t tag_end = end_of_tag(bytes, open);
   if (tag_end == bytes.size()) fail(file, "the file ends inside <AppendedData> (truncated?)");
   encoding.has_appended = true;
   if (bytes[tag_end - 1] == '/') {  // <AppendedData/>: no data
@@ -349,6 +338,21 @@ pugi::xml_node only_child(const fs::path& file, const pugi::xml_node& parent,
 }
 
 }  // namespace
+
+std::size_t end_of_tag(std::string_view text, std::size_t open) {
+  char quote = 0;
+  for (std::size_t at = open; at < text.size(); ++at) {
+    const char c = text[at];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      return at;
+    }
+  }
+  return text.size();
+}
 
 void parse_vtu(const fs::path& file, std::string_view bytes, VtuDocument& out) {
   Encoding encoding;

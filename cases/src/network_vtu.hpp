@@ -21,6 +21,10 @@ struct VtuDocument {
   VtkGrid grid;
 };
 
+/// Where the tag that starts at `open` ('<') ends: the index of its '>' outside quoted attribute
+/// values, or text.size() where the text ends first.
+std::size_t end_of_tag(std::string_view text, std::size_t open);
+
 /// Parses and decodes every array; every fault is an InputError naming `file`.
 void parse_vtu(const fs::path& file, std::string_view bytes, VtuDocument& out);
 

@@ -208,18 +208,8 @@ std::pair<std::size_t, std::size_t> element_range(const fs::path& file, const Vt
       xml[static_cast<std::size_t>(name) - 1] != '<')
     fail(file, "cannot locate the DataArray to rewrite");
   const std::size_t begin = static_cast<std::size_t>(name) - 1;
-  std::size_t tag_end = begin;
-  char quote = 0;
-  for (; tag_end < xml.size(); ++tag_end) {
-    const char c = xml[tag_end];
-    if (quote) {
-      if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '>') {
-      break;
-    }
-  }
+  const std::size_t tag_end = end_of_tag(xml, begin);
+  if (tag_end == xml.size()) fail(file, "cannot locate the DataArray to rewrite");
   std::size_t end = tag_end + 1;
   if (xml[tag_end - 1] != '/') {
     const std::size_t close = xml.find("</DataArray", tag_end);

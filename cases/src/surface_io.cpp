@@ -234,28 +234,6 @@ void check_scale(const fs::path& file, const Surface& s) {
   }
 }
 
-/// Writes all bytes to `temporary` and renames it to `file`; on failure removes `temporary`.
-void put_on_disk(const fs::path& file, const fs::path& temporary, const std::string& bytes) {
-  std::FILE* out = std::fopen(temporary.c_str(), "wb");
-  if (!out) detail::fail(file, std::string("cannot write: ") + std::strerror(errno));
-  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
-  const int write_errno = errno;
-  const bool closed = std::fclose(out) == 0;
-  const int close_errno = errno;
-  std::error_code ignored;
-  if (!written || !closed) {
-    fs::remove(temporary, ignored);
-    detail::fail(
-        file, std::string("cannot write: ") + std::strerror(!written ? write_errno : close_errno));
-  }
-  std::error_code renamed;
-  fs::rename(temporary, file, renamed);
-  if (renamed) {
-    fs::remove(temporary, ignored);
-    detail::fail(file, "cannot write: " + renamed.message());
-  }
-}
-
 }  // namespace
 
 SurfaceFormat surface_format_for(const fs::path& path) {
@@ -320,7 +298,32 @@ void write_surface(const fs::path& path, const Surface& surface,
   // Same folder, so the rename is atomic; the pid keeps concurrent writers apart.
   fs::path temporary = path;
   temporary += ".tmp." + std::to_string(::getpid());
-  put_on_disk(path, temporary, bytes);
+  detail::put_on_disk(path, temporary, bytes);
 }
+
+namespace detail {
+
+void put_on_disk(const fs::path& file, const fs::path& temporary, const std::string& bytes) {
+  std::FILE* out = std::fopen(temporary.c_str(), "wb");
+  if (!out) detail::fail(file, std::string("cannot write: ") + std::strerror(errno));
+  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
+  const int write_errno = errno;
+  const bool closed = std::fclose(out) == 0;
+  const int close_errno = errno;
+  std::error_code ignored;
+  if (!written || !closed) {
+    fs::remove(temporary, ignored);
+    detail::fail(
+        file, std::string("cannot write: ") + std::strerror(!written ? write_errno : close_errno));
+  }
+  std::error_code renamed;
+  fs::rename(temporary, file, renamed);
+  if (renamed) {
+    fs::remove(temporary, ignored);
+    detail::fail(file, "cannot write: " + renamed.message());
+  }
+}
+
+}  // namespace detail
 
 }  // namespace msfem::cases

@@ -91,4 +91,8 @@ void write_stl(const fs::path& file, std::string& out, const Surface& surface,
                const std::string& unit_name, bool binary);
 void write_ply(std::string& out, const Surface& surface, const std::string& unit_name, bool binary);
 
+/// Writes all bytes to `temporary` and renames it to `file` (readers see the old file or the new,
+/// never half of one); on failure removes `temporary` and throws InputError naming `file`.
+void put_on_disk(const fs::path& file, const fs::path& temporary, const std::string& bytes);
+
 }  // namespace msfem::cases::detail
