@@ -9,6 +9,7 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/modulus_image.hpp"
+#include "msfem/cases/network_file.hpp"
 #include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/units.hpp"
@@ -61,10 +62,12 @@ void check_hu_table(const MaterialParameters& m) {
 void check_geometry_unit(const GeometryParameters& geometry) {
   if (geometry.unit == LengthUnit::metre) return;
   const bool image = is_image_source(geometry.source);
-  if (image || is_surface_generator(geometry.source))
+  const bool network = is_network_source(geometry.source);
+  if (image || network || is_surface_generator(geometry.source))
     throw InputError("geometry/unit = " + to_string(geometry.unit) + " has no effect on " +
-                     (image ? "an image source (its header gives the voxel size in world units)"
-                            : "a generated surface (its sizes are in metres)") +
+                     (image     ? "an image source (its header gives the voxel size in world units)"
+                      : network ? "a network's surface (network files are in metres)"
+                                : "a generated surface (its sizes are in metres)") +
                      ": remove it");
 }
 

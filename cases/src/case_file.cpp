@@ -16,6 +16,7 @@
 #include "case_consistency.hpp"
 #include "case_file_text.hpp"
 #include "case_lists.hpp"
+#include "case_paths.hpp"
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/modulus_image.hpp"
@@ -42,7 +43,8 @@ void declare_geometry(ParameterHandler& prm) {
                     "Closed surface: a file (.obj .stl .off .ply; relative to the case file), "
                     "a generator, icosphere:LEVEL[:RADIUS_M] or ellipsoid:LEVEL:A:B:C (metres), "
                     "or an organ of a NIfTI image, image:FILE:label=N or "
-                    "image:FILE:threshold=LO[:HI] (FILE relative to the case file; unit unused).");
+                    "image:FILE:threshold=LO[:HI] (FILE relative to the case file; unit unused), "
+                    "or a network's own surface triangles, network:FILE (.vtu, .vtk; metres).");
   prm.declare_entry("unit", "m", Patterns::Selection(selection_of<LengthUnit>()),
                     "Unit of the surface file's coordinates; msfem works in metres.");
   prm.declare_entry("simplify to vertices", "0", Patterns::Integer(0),
@@ -554,27 +556,7 @@ CaseParameters read_case(const std::filesystem::path& file,
   }
   c.file = file;
   c.name = file.stem().string();
-  for (auto& network : c.mass_spring.networks) {
-    if (network.file.is_relative())
-      network.file = (file.parent_path() / network.file).lexically_normal();
-    if (!std::filesystem::is_regular_file(network.file))
-      throw InputError(file.string() + ": mass spring/networks: " + network.name + "=" +
-                       network.file.string() + ": no such file");
-  }
-  // A relative surface path is relative to the case file, so cases run from any folder.
-  if (is_image_source(c.geometry.source)) {
-    try {
-      c.geometry.source = image_source_relative_to(c.geometry.source, file.parent_path());
-    } catch (const InputError& e) {
-      throw InputError(file.string() + ": " + e.what());
-    }
-  } else if (!is_surface_generator(c.geometry.source)) {
-    const std::filesystem::path p(c.geometry.source);
-    if (p.is_relative()) c.geometry.source = (file.parent_path() / p).lexically_normal().string();
-  }
-  if (const std::filesystem::path image(c.material.youngs_modulus_image);
-      !image.empty() && image.is_relative())
-    c.material.youngs_modulus_image = (file.parent_path() / image).lexically_normal().string();
+  resolve_paths(c);
   return c;
 }
 

@@ -200,6 +200,40 @@ void put_on_disk(const fs::path& file, const std::string& bytes) {
 
 }  // namespace
 
+bool is_network_source(const std::string& source) {
+  return source.rfind("network:", 0) == 0;
+}
+
+fs::path network_source_file(const std::string& source) {
+  return source.substr(std::string("network:").size());
+}
+
+Surface network_surface(const fs::path& file) {
+  const NetworkFile n = read_network(file);
+  if (n.triangles.rows() == 0)
+    detail::fail(file,
+                 "geometry/source = network: takes the file's surface triangles, and it has "
+                 "none (Xsp carries none: give the case a surface and the network in mass "
+                 "spring/networks)");
+  std::vector<int> vertex_of(static_cast<std::size_t>(n.points.rows()), -1);
+  for (Eigen::Index t = 0; t < n.triangles.rows(); ++t)
+    for (int c = 0; c < 3; ++c)
+      vertex_of[static_cast<std::size_t>(n.triangles(t, c))] = 0;
+  int count = 0;
+  for (int& v : vertex_of)
+    if (v == 0) v = count++;
+  Surface s;
+  s.vertices.resize(count, 3);
+  for (Eigen::Index p = 0; p < n.points.rows(); ++p)
+    if (vertex_of[static_cast<std::size_t>(p)] >= 0)
+      s.vertices.row(vertex_of[static_cast<std::size_t>(p)]) = n.points.row(p);
+  s.triangles.resize(n.triangles.rows(), 3);
+  for (Eigen::Index t = 0; t < n.triangles.rows(); ++t)
+    for (int c = 0; c < 3; ++c)
+      s.triangles(t, c) = vertex_of[static_cast<std::size_t>(n.triangles(t, c))];
+  return s;
+}
+
 NetworkFile read_network(const fs::path& file) {
   format_for(file);
   return read_checked(file, detail::read_whole_file(file)).network;

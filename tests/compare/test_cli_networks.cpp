@@ -128,6 +128,33 @@ TEST(CliNetworks, AFrictionlessToolPressesANetworkAsItsVariant) {
   expect_same_variant(variant(s, "single_layer"), variant(s, "b"), "contact single_layer");
 }
 
+// The network's own surface as the case's geometry: the FEM is meshed on it and compared node to
+// node; the three tiers' outer tier is the sphere's surface, so the run is the sphere's.
+TEST(CliNetworks, TheNetworksOwnSurfaceIsTheCasesGeometry) {
+  TemporaryDirectory tmp;
+  const std::string tiers = every + " --set 'mass spring/variants=three_tier'";
+  ASSERT_EQ(run_msfem("export-network " + tiers + " " + (tmp / "nets").string()).exit_code, 0);
+  const std::string file = (tmp / "nets" / "three_tier.vtu").string();
+  const auto own =
+      run_msfem("run " + tiers + quietly + " --set geometry/source=network:" + file +
+                " --set 'mass spring/networks=mine=" + file + "' --out " + (tmp / "own").string());
+  ASSERT_EQ(own.exit_code, 0) << own.err;
+  const auto sphere = run_msfem("run " + tiers + quietly + " --out " + (tmp / "sphere").string());
+  ASSERT_EQ(sphere.exit_code, 0) << sphere.err;
+  const auto a = nlohmann::json::parse(read_text(tmp / "own" / "summary.json"));
+  const auto b = nlohmann::json::parse(read_text(tmp / "sphere" / "summary.json"));
+  expect_same_variant(variant(b, "three_tier"), variant(a, "mine"), "network surface");
+  expect_same(a["fem"]["reaction_force_N"][2], b["fem"]["reaction_force_N"][2], "fem force", 1e-9);
+  // Xsp has no triangles to be a surface.
+  const auto xsp =
+      run_msfem("run " + every + quietly + " --set geometry/source=network:" +
+                (tmp / "nets" / "three_tier.xs3").string() + " --out " + (tmp / "xsp").string());
+  EXPECT_EQ(xsp.exit_code, 2) << xsp.err;
+  EXPECT_NE(xsp.err.find("three_tier.xs3: geometry/source = network: takes the file's surface"),
+            std::string::npos)
+      << xsp.err;
+}
+
 TEST(CliNetworks, ANetworkOfAnotherGeometryIsRefusedNamingTheVertex) {
   TemporaryDirectory tmp;
   ASSERT_EQ(run_msfem("export-network " + every + " " + (tmp / "nets").string()).exit_code, 0);

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/network_file.hpp"
 #include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/cases/surface_io.hpp"
@@ -370,6 +371,8 @@ ToolPlacement at_depth(ToolPlacement tool, double depth) {
 
 cases::Surface source_surface(const cases::CaseParameters& p, std::vector<std::string>& notes) {
   const auto& g = p.geometry;
+  if (cases::is_network_source(g.source))
+    return cases::network_surface(cases::network_source_file(g.source));
   return cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
          : cases::is_image_source(g.source)    ? surface_of_image(g.source, notes)
                                                : cases::read_surface(g.source, g.unit);

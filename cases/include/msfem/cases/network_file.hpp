@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "msfem/cases/surface.hpp"
+
 namespace msfem::cases {
 
 struct NetworkFile {
@@ -83,5 +85,13 @@ void write_network_with_coefficients(const std::filesystem::path& original,
                                      const std::filesystem::path& out,
                                      const Eigen::VectorXd& stiffness,
                                      const std::optional<Eigen::VectorXd>& damping);
+
+/// `geometry/source = network:FILE`: the case's surface is the network's own surface triangles,
+/// their points kept (in increasing point id), so that the FEM is meshed on the simulator's
+/// surface and compared with the network node to node.
+bool is_network_source(const std::string& source);
+std::filesystem::path network_source_file(const std::string& source);
+/// The surface of a network file's triangles; InputError naming the file where it has none (Xsp).
+Surface network_surface(const std::filesystem::path& file);
 
 }  // namespace msfem::cases
