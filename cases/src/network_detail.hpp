@@ -88,6 +88,12 @@ struct VtkArray {
   }
 };
 
+/// A cell array's values with the springs' replaced: `cells` values, those of `original` (0 where
+/// it is absent), and per_spring[s] at the cell spring_cells[s]: what a coefficient rewrite writes.
+std::vector<double> with_spring_values(const VtkArray* original, std::size_t cells,
+                                       const std::vector<long long>& spring_cells,
+                                       const Eigen::VectorXd& per_spring);
+
 /// Appends `count` words of `type` from `bytes` (exactly count * size_of(type) of them) to
 /// `array`; false when a UInt64 does not fit a signed 64-bit integer.
 bool decode_words(std::string_view bytes, std::size_t count, ValueType type, bool big_endian,

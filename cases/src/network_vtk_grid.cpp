@@ -86,6 +86,18 @@ long long integral(const fs::path& file, const std::string& label, const char* n
 
 }  // namespace
 
+std::vector<double> with_spring_values(const VtkArray* original, std::size_t cells,
+                                       const std::vector<long long>& spring_cells,
+                                       const Eigen::VectorXd& per_spring) {
+  std::vector<double> values(cells, 0.0);
+  if (original)
+    for (std::size_t c = 0; c < cells; ++c)
+      values[c] = original->value(c);
+  for (std::size_t s = 0; s < spring_cells.size(); ++s)
+    values[static_cast<std::size_t>(spring_cells[s])] = per_spring(static_cast<Eigen::Index>(s));
+  return values;
+}
+
 std::string unread_array(const std::string& where, const std::string& name) {
   return where + " array " + detail::quoted(name) +
          " is not one msfem reads: stiffness, damping, rest_length, group, bulk_modulus (cell "

@@ -445,14 +445,7 @@ std::string vtk_legacy_with_coefficients(const fs::path& file, std::string_view 
     return nullptr;
   };
   const auto per_cell = [&](const VtkArray* array, const Eigen::VectorXd& per_spring) {
-    std::vector<double> values(legacy.grid.cell_types.size(), 0.0);
-    if (array)
-      for (std::size_t c = 0; c < values.size(); ++c)
-        values[c] = array->value(c);
-    for (std::size_t s = 0; s < read.origin.spring.size(); ++s)
-      values[static_cast<std::size_t>(read.origin.spring[s])] =
-          per_spring(static_cast<Eigen::Index>(s));
-    return values;
+    return with_spring_values(array, legacy.grid.cell_types.size(), read.origin.spring, per_spring);
   };
   struct Splice {
     std::size_t begin, end;

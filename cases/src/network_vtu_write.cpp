@@ -268,13 +268,7 @@ std::string vtu_with_coefficients(const fs::path& file, std::string_view bytes,
     return nullptr;
   };
   const auto new_values = [&](const VtkArray* original, const Eigen::VectorXd& per_spring) {
-    std::vector<double> values(doc.grid.cell_types.size(), 0.0);
-    if (original)
-      for (std::size_t c = 0; c < values.size(); ++c)
-        values[c] = original->value(c);
-    for (std::size_t s = 0; s < spring_cells.size(); ++s)
-      values[static_cast<std::size_t>(spring_cells[s])] = per_spring(static_cast<Eigen::Index>(s));
-    return values;
+    return with_spring_values(original, doc.grid.cell_types.size(), spring_cells, per_spring);
   };
   const auto indent_of = [&](std::size_t begin) {
     std::size_t line = begin;
