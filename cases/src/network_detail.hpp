@@ -88,6 +88,16 @@ struct VtkArray {
   }
 };
 
+/// A file's bytes [begin, end) to be replaced by `text`: how a coefficient rewrite keeps every
+/// other byte of the user's file.
+struct Splice {
+  std::size_t begin, end;
+  std::string text;
+};
+
+/// `bytes` with every splice applied (they must not overlap).
+std::string spliced(std::string_view bytes, std::vector<Splice> splices);
+
 /// A cell array's values with the springs' replaced: `cells` values, those of `original` (0 where
 /// it is absent), and per_spring[s] at the cell spring_cells[s]: what a coefficient rewrite writes.
 std::vector<double> with_spring_values(const VtkArray* original, std::size_t cells,

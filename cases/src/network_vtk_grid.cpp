@@ -86,6 +86,16 @@ long long integral(const fs::path& file, const std::string& label, const char* n
 
 }  // namespace
 
+std::string spliced(std::string_view bytes, std::vector<Splice> splices) {
+  // From the last to the first, so that each splice's offsets still hold.
+  std::sort(splices.begin(), splices.end(),
+            [](const Splice& a, const Splice& b) { return a.begin > b.begin; });
+  std::string out(bytes);
+  for (const Splice& splice : splices)
+    out.replace(splice.begin, splice.end - splice.begin, splice.text);
+  return out;
+}
+
 std::vector<double> with_spring_values(const VtkArray* original, std::size_t cells,
                                        const std::vector<long long>& spring_cells,
                                        const Eigen::VectorXd& per_spring) {

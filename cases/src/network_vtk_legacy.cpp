@@ -447,10 +447,6 @@ std::string vtk_legacy_with_coefficients(const fs::path& file, std::string_view 
   const auto per_cell = [&](const VtkArray* array, const Eigen::VectorXd& per_spring) {
     return with_spring_values(array, legacy.grid.cell_types.size(), read.origin.spring, per_spring);
   };
-  struct Splice {
-    std::size_t begin, end;
-    std::string text;
-  };
   std::vector<Splice> splices;
   const auto replace = [&](const Range& range, const char* name, const Eigen::VectorXd& values) {
     if (!is_real(range.type))
@@ -469,12 +465,7 @@ std::string vtk_legacy_with_coefficients(const fs::path& file, std::string_view 
             data_text(per_cell(nullptr, *damping), ValueType::float64, legacy.binary) + "\n";
     splices.push_back({at, at, text});
   }
-  std::sort(splices.begin(), splices.end(),
-            [](const Splice& a, const Splice& b) { return a.begin > b.begin; });
-  std::string out(bytes);
-  for (const Splice& splice : splices)
-    out.replace(splice.begin, splice.end - splice.begin, splice.text);
-  return out;
+  return spliced(bytes, std::move(splices));
 }
 
 }  // namespace msfem::cases::detail

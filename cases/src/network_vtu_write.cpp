@@ -193,11 +193,6 @@ void write_vtu(std::string& out, const NetworkFile& net) {
 
 namespace {
 
-struct Splice {
-  std::size_t begin, end;
-  std::string text;
-};
-
 /// The bytes [begin, end) of a DataArray element, from '<' to the end of its end tag.
 std::pair<std::size_t, std::size_t> element_range(const fs::path& file, const VtuDocument& doc,
                                                   const pugi::xml_node& node) {
@@ -299,12 +294,7 @@ std::string vtu_with_coefficients(const fs::path& file, std::string_view bytes,
                                            new_values(nullptr, *damping), indent)});
     }
   }
-  std::sort(splices.begin(), splices.end(),
-            [](const Splice& a, const Splice& b) { return a.begin > b.begin; });
-  std::string out(bytes);
-  for (const Splice& splice : splices)
-    out.replace(splice.begin, splice.end - splice.begin, splice.text);
-  return out;
+  return spliced(bytes, std::move(splices));
 }
 
 }  // namespace msfem::cases::detail
