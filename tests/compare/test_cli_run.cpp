@@ -534,8 +534,17 @@ TEST(RunOptions, EachLoadsReferenceIsCachedOnItsOwn) {
   for (const auto* other : {&b, &c}) {
     EXPECT_EQ((*other)["fem"]["loads"][1]["reaction_force_N"],
               a["fem"]["loads"][1]["reaction_force_N"]);
-    EXPECT_EQ((*other)["fem"]["loads"][0]["reaction_force_N"],
-              a["fem"]["loads"][0]["reaction_force_N"]);
+    // The first load is solved again without its curve, along a different path of steps, so
+    // its force agrees to the solver's tolerance, not bit for bit; read from the cache it is exact.
+    const auto& f0 = (*other)["fem"]["loads"][0]["reaction_force_N"];
+    const auto& a0 = a["fem"]["loads"][0]["reaction_force_N"];
+    const double scale = std::abs(a0[2].get<double>());
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (other == &c)
+        EXPECT_EQ(f0[k], a0[k]) << k;
+      else
+        EXPECT_NEAR(f0[k].get<double>(), a0[k].get<double>(), 1e-9 * scale) << k;
+    }
     const auto& tools = (*other)["variants"][0]["loads"]["per_tool"];
     for (std::size_t t = 0; t < 2; ++t)
       EXPECT_DOUBLE_EQ(tools[t]["rel_l2_error"].get<double>(),
