@@ -244,9 +244,11 @@ void declare_fem_timing_output(ParameterHandler& prm) {
 void declare_calibration(ParameterHandler& prm) {
   prm.enter_subsection("calibration");
   // The empty first choice is "not set".
-  prm.declare_entry("variant", "", Patterns::Selection("|" + selection_of<Variant>()),
-                    "Variant msfem calibrate fits when --variant is not given (empty: the first "
-                    "of mass spring/variants).");
+  prm.declare_entry("variant", "", Patterns::Anything(),
+                    "Variant msfem calibrate fits when --variant is not given: a built-in one (" +
+                        selection_of<Variant>() +
+                        ") or a NAME of mass spring/networks (empty: the first of mass "
+                        "spring/variants, else the first network).");
   prm.declare_entry("fit groups", "", Patterns::List(Patterns::Anything()),
                     "Spring groups whose stiffness is fitted (empty: every group of the variant).");
   prm.declare_entry("train loads", "", Patterns::Anything(),
@@ -487,8 +489,13 @@ void extract_fem_timing_output(ParameterHandler& prm, CaseParameters& c) {
 void extract_calibration(ParameterHandler& prm, CaseParameters& c) {
   prm.enter_subsection("calibration");
   auto& cal = c.calibration;
-  if (const std::string variant = prm.get("variant"); !variant.empty())
-    cal.variant = parse_setting<Variant>(variant, "calibration/variant");
+  if (const std::string variant = prm.get("variant"); !variant.empty()) {
+    const auto& networks = c.mass_spring.networks;
+    if (std::none_of(networks.begin(), networks.end(),
+                     [&](const auto& n) { return n.name == variant; }))
+      parse_setting<Variant>(variant, "calibration/variant");  // else a built-in one, or refused
+    cal.variant = variant;
+  }
   cal.groups = dealii::Utilities::split_string_list(prm.get("fit groups"));
   cal.train = parse_tool_loads(prm.get("train loads"), "calibration/train loads");
   cal.test = parse_tool_loads(prm.get("test loads"), "calibration/test loads");

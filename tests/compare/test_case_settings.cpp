@@ -102,9 +102,30 @@ TEST(CaseSettings, EveryEnumeratedKeyTakesExactlyItsTable) {
       "timing/integrator", [](const CaseParameters& p) { return p.timing.integrator; });
   expect_language_takes_exactly_the_table<cases::CalibrationModel>(
       "calibration/model", [](const CaseParameters& p) { return p.calibration.model; });
-  expect_language_takes_exactly_the_table<cases::Variant>(
-      "calibration/variant", [](const CaseParameters& p) { return *p.calibration.variant; });
   EXPECT_FALSE(with({}).calibration.variant.has_value());  // empty: the first of the variants
+}
+
+// calibration/variant names a built-in variant or one of the case's networks; anything else is
+// refused naming the key and the value.
+TEST(CaseSettings, TheCalibratedVariantIsABuiltInOneOrANetworkOfTheCase) {
+  for (const auto& entry : cases::names_of(cases::Variant{}).entries)
+    EXPECT_EQ(with({std::string("calibration/variant=") + entry.name}).calibration.variant,
+              std::string(entry.name));
+  TemporaryDirectory dir;
+  std::ofstream(dir / "mine.vtu") << "";  // read when a run builds it, not with the case
+  EXPECT_EQ(with({"mass spring/networks=mine=" + (dir / "mine.vtu").string(),
+                  "calibration/variant=mine"})
+                .calibration.variant,
+            "mine");
+  try {
+    with({"calibration/variant=no_such_value"});
+    ADD_FAILURE() << "an unknown variant was accepted";
+  } catch (const cases::InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("calibration/variant: unknown value 'no_such_value'"),
+              std::string::npos)
+        << message;
+  }
 }
 
 // The length unit scales a surface file's coordinates into metres.

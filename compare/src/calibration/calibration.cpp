@@ -397,6 +397,13 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                          cases::Variant variant, const std::vector<CalibrationLoad>& train,
                          const std::vector<CalibrationLoad>& test,
                          const CalibrationOptions& options) {
+  return calibrate(problem, mesh, builtin_spec(variant), train, test, options);
+}
+
+CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                         const VariantSpec& variant, const std::vector<CalibrationLoad>& train,
+                         const std::vector<CalibrationLoad>& test,
+                         const CalibrationOptions& options) {
   const auto start = Clock::now();
   const std::string& file = problem.parameters.file.string();
   if (train.empty())

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/network_file.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/cases/surface_from_image.hpp"
 #include "msfem/cases/surface_generators.hpp"
@@ -16,23 +17,25 @@
 namespace msfem::compare {
 namespace {
 
-cases::Variant resolve_variant(const cases::CaseParameters& p, const CalibrationRequest& request) {
-  if (p.mass_spring.variants.empty() && !request.variant && !p.calibration.variant)
+// The variant to fit: --variant, else calibration/variant, else the case's first (a built-in
+// one, else a network); it must be one the case runs.
+VariantSpec resolve_variant(const cases::CaseParameters& p, const CalibrationRequest& request) {
+  const std::vector<VariantSpec> defined = variant_specs(p);
+  if (defined.empty())
     throw cases::InputError(p.file.string() +
-                            ": msfem calibrate fits a built-in variant, and mass spring/variants "
-                            "is empty (a network from mass spring/networks is not fitted yet)");
-  const cases::Variant variant = request.variant         ? *request.variant
-                                 : p.calibration.variant ? *p.calibration.variant
-                                                         : p.mass_spring.variants.front();
-  const auto& defined = p.mass_spring.variants;
-  if (std::find(defined.begin(), defined.end(), variant) == defined.end()) {
-    std::string list;
-    for (const auto& v : defined)
-      list += (list.empty() ? "" : ", ") + cases::name_of(v);
-    throw cases::InputError(p.file.string() + ": --variant " + cases::name_of(variant) +
-                            ": the case does not define it (mass spring/variants = " + list + ")");
-  }
-  return variant;
+                            ": msfem calibrate: the case has no variant (mass spring/variants and "
+                            "mass spring/networks are empty)");
+  const std::optional<std::string> asked =
+      request.variant ? request.variant : p.calibration.variant;
+  if (!asked) return defined.front();
+  for (const VariantSpec& spec : defined)
+    if (spec.name == *asked) return spec;
+  std::string list;
+  for (const auto& v : defined)
+    list += (list.empty() ? "" : ", ") + v.name;
+  throw cases::InputError(p.file.string() + ": " +
+                          (request.variant ? "--variant " : "calibration/variant = ") + *asked +
+                          ": the case does not run it (its variants and networks: " + list + ")");
 }
 
 void check_loads(const cases::CaseParameters& p, const std::vector<cases::ToolLoad>& train,
@@ -59,20 +62,39 @@ void check_loads(const cases::CaseParameters& p, const std::vector<cases::ToolLo
   check_unique(test, "held-out");
 }
 
-// Before any solve: every group to fit is one the variant has.
-void check_fit_groups(const cases::CaseParameters& p, cases::Variant variant,
-                      const std::vector<std::string>& groups) {
-  const std::vector<std::string> known = spring_groups_of(variant, p);
+// Before any solve: every group to fit is one the variant has. A network hands its fit back as
+// its own file with new spring coefficients, so its groups to fit are its spring groups (every one
+// when none is named); the modulus of its volume elements stays the file's.
+std::vector<std::string> checked_fit_groups(const cases::CaseParameters& p,
+                                            const VariantSpec& variant,
+                                            std::vector<std::string> groups) {
+  std::vector<std::string> known;
+  if (variant.builtin) {
+    known = spring_groups_of(*variant.builtin, p);
+  } else {
+    try {
+      known = network_groups(variant.network);
+    } catch (const cases::InputError& e) {
+      throw cases::InputError(p.file.string() + ": mass spring/networks: " + variant.name + "=" +
+                              variant.network.string() + ": " + e.what());
+    }
+    known.erase(std::remove(known.begin(), known.end(), volume_group), known.end());
+    if (groups.empty()) groups = known;
+  }
   for (const auto& g : groups)
     if (std::find(known.begin(), known.end(), g) == known.end()) {
       std::string list;
       for (const auto& k : known)
         list += (list.empty() ? "" : ", ") + k;
-      throw cases::InputError(p.file.string() + ": calibration: variant " +
-                              cases::name_of(variant) + " has no group '" + g +
-                              "' (its groups: " + list +
-                              (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
+      const std::string hint =
+          g != volume_group    ? ""
+          : variant.builtin    ? "; " + std::string(volume_hint)
+                               : "; a network's fit is handed back as new spring coefficients in "
+                                 "its file, and its volume elements keep the file's bulk_modulus";
+      throw cases::InputError(p.file.string() + ": calibration: variant " + variant.name +
+                              " has no group '" + g + "' to fit (its groups: " + list + hint + ")");
     }
+  return groups;
 }
 
 // The case with its tool enabled at every direction the loads use, as deep as the deepest load
@@ -225,8 +247,8 @@ void set_options(CaseCalibration& c, const cases::CaseParameters& parameters,
                             "loads/tool/mode = contact: use calibration/model = nonlinear (the "
                             "default) to calibrate in contact");
   check_group_names(parameters);
-  c.options.groups = request.groups.value_or(defaults.groups);
-  check_fit_groups(parameters, c.variant, c.options.groups);
+  c.options.groups =
+      checked_fit_groups(parameters, c.variant, request.groups.value_or(defaults.groups));
   c.options.force_weight = defaults.force_weight;
   c.options.max_evaluations = defaults.max_evaluations;
   c.options.tolerance = defaults.tolerance;
@@ -236,7 +258,7 @@ void set_options(CaseCalibration& c, const cases::CaseParameters& parameters,
 }
 
 void fit(CaseCalibration& c, const Progress& progress) {
-  progress.stage("fitting " + cases::name_of(c.variant) + " (BOBYQA, at most " +
+  progress.stage("fitting " + c.variant.name + " (BOBYQA, at most " +
                  std::to_string(c.options.max_evaluations) + " evaluations of " +
                  std::to_string(c.train.size()) + " static solves)");
   const auto fit_start = Clock::now();
@@ -252,10 +274,36 @@ void fit(CaseCalibration& c, const Progress& progress) {
   if (const std::string few = loads_with_few_tool_nodes(c.fit.before); !few.empty())
     c.notes.push_back(
         "the tool holds fewer than " + std::to_string(min_tool_patch_nodes) + " surface nodes of " +
-        cases::name_of(c.variant) + " at " + few +
+        c.variant.name + " at " + few +
         ": such a patch's force grows about linearly with depth while the FEM's resolved contact "
         "grows faster, so no stiffness fits every depth; only a surface fine enough under the "
         "tool for the patch to grow with depth can follow it");
+}
+
+// The network with the fit put in, as its simulator loads it: the fitted groups' stiffness (the
+// file's times the fitted factor, the case's scale included), and where the file carries its own
+// dampers, those of the fitted damping ratio; calibrated.prm runs it in place of the user's file.
+void hand_back_network(CaseCalibration& c, const cases::CaseParameters& parameters,
+                       const massspring::MassSpringModel& calibrated) {
+  const cases::NetworkFile file = cases::read_network(c.variant.network);
+  NetworkHandBack h;
+  h.original = c.variant.network;
+  h.file_name = "calibrated_" + c.variant.name + c.variant.network.extension().string();
+  h.stiffness = file.stiffness;
+  for (const FittedGroup& g : c.fit.groups) {
+    const auto it = std::find(file.group_names.begin(), file.group_names.end(), g.group);
+    const int id = static_cast<int>(it - file.group_names.begin());
+    for (Eigen::Index s = 0; s < h.stiffness.size(); ++s)
+      if (file.spring_group[s] == id) h.stiffness[s] *= g.case_factor;
+  }
+  if (file.damping && c.damping.reachable)
+    h.damping = massspring::damping_for_ratio(calibrated.network(), c.damping.case_damping_ratio);
+  std::string networks = "mass spring/networks=";
+  for (const auto& n : parameters.mass_spring.networks)
+    networks += (&n == &parameters.mass_spring.networks.front() ? "" : "; ") + n.name + "=" +
+                (n.name == c.variant.name ? h.file_name : std::filesystem::absolute(n.file).string());
+  c.calibrated_overrides.push_back(networks);
+  c.hand_back = std::move(h);
 }
 
 // The calibrated case as calibrated.prm states it, re-solved from the file's values: it checks
@@ -263,12 +311,14 @@ void fit(CaseCalibration& c, const Progress& progress) {
 void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& parameters,
                            const CalibrationRequest& request) {
   c.calibrated_overrides = request.overrides;
-  c.calibrated_overrides.push_back("calibration/variant=" + cases::name_of(c.variant));
+  c.calibrated_overrides.push_back("calibration/variant=" + c.variant.name);
   Problem calibrated = c.problem;
   calibrated.parameters.mass_spring.group_scales =
       calibrated_group_scales(parameters, c.fit.groups);
-  c.calibrated_overrides.push_back(
-      group_scales_assignment(calibrated.parameters.mass_spring.group_scales));
+  auto written_scales = calibrated.parameters.mass_spring.group_scales;
+  if (!c.variant.builtin)  // a network's fitted values go into its own file, not the scales
+    written_scales.resize(written_scales.size() - c.fit.groups.size());
+  c.calibrated_overrides.push_back(group_scales_assignment(written_scales));
   BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
   Eigen::VectorXd x;
   const LoadErrors check =
@@ -297,8 +347,13 @@ void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& para
     c.notes.push_back(
         "damping: spring dampers cannot give the tool-response mode the target ratio");
   }
+  if (!c.variant.builtin) hand_back_network(c, parameters, *built.model);
   const std::string& source = parameters.geometry.source;
-  if (cases::is_image_source(source))
+  if (cases::is_network_source(source))
+    c.calibrated_overrides.push_back(
+        "geometry/source=network:" +
+        std::filesystem::absolute(cases::network_source_file(source)).string());
+  else if (cases::is_image_source(source))
     c.calibrated_overrides.push_back(
         "geometry/source=" +
         cases::image_source_relative_to(source, std::filesystem::current_path()));
@@ -313,13 +368,13 @@ void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& para
 // (nonlinear or linearised), ranked with the calibrated one.
 void compare_on_held_out_loads(CaseCalibration& c, const cases::CaseParameters& parameters,
                                const CalibrationRequest& request, const Progress& progress) {
-  c.variants.push_back(mean_on(cases::name_of(c.variant), true, c.fit.after.test));
+  c.variants.push_back(mean_on(c.variant.name, true, c.fit.after.test));
   if (request.compare_variants && !c.test.empty()) {
-    for (const cases::Variant kind : parameters.mass_spring.variants) {
-      if (kind == c.variant) continue;
-      const std::string name = cases::name_of(kind);
+    for (const VariantSpec& spec : variant_specs(parameters)) {
+      if (spec.name == c.variant.name) continue;
+      const std::string& name = spec.name;
       progress.stage("held-out loads on " + name + " (as the case has it) for comparison");
-      BuiltVariant other = build_variant(kind, c.problem, c.mesh, c.test.front().tool);
+      BuiltVariant other = build_variant(spec, c.problem, c.mesh, c.test.front().tool);
       std::vector<LoadErrors> errors;
       try {
         for (const auto& r : c.test) {

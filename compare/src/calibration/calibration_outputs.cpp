@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "msfem/cases/network_file.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/calibration/calibration_case.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
@@ -88,7 +89,7 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
   const auto& p = c.problem.parameters;
   const auto& fit = c.fit;
   std::ostringstream md;
-  md << "# msfem calibrate: " << p.name << ", variant " << cases::name_of(c.variant) << "\n\n"
+  md << "# msfem calibrate: " << p.name << ", variant " << c.variant.name << "\n\n"
      << "- case file: `" << p.file.string() << "`; surface " << c.problem.surface.num_vertices()
      << " vertices; E = " << p.material.youngs_modulus_pa << " Pa, ν = " << p.material.poisson_ratio
      << "\n"
@@ -150,6 +151,12 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
   md << "## Files\n\n- `calibration.json`: every number above\n"
         "- `calibrated.prm`: the case with the fitted group scales and damping ratio (`msfem run "
         "calibrated.prm`)\n";
+  if (c.hand_back)
+    md << "- `" << c.hand_back->file_name << "`: " << c.hand_back->original.filename().string()
+       << " with the fitted groups' stiffness"
+       << (c.hand_back->damping ? " and the fitted damping" : "")
+       << " put in, every other array and the cell order kept (calibrated.prm runs it as "
+       << c.variant.name << ")\n";
   return md.str();
 }
 
@@ -178,7 +185,8 @@ nlohmann::json calibration_json(const CaseCalibration& c) {
                         {"mean_test_rel_l2_error", v.mean_rel_l2_error},
                         {"mean_test_reaction_force_rel_error", v.mean_reaction_force_rel_error}});
   return {{"case", c.problem.parameters.name},
-          {"variant", cases::name_of(c.variant)},
+          {"variant", c.variant.name},
+          {"calibrated_network", c.hand_back ? nlohmann::json(c.hand_back->file_name) : nullptr},
           {"git_revision", git_revision()},
           {"objective",
            {{"definition",
@@ -246,15 +254,18 @@ void write_calibration_outputs(const CaseCalibration& c, const std::filesystem::
       best.x.push_back(static_cast<double>(i + 1));
       best.y.push_back(std::max(lowest, 1e-300));
     }
-    plot = xy_lines(dir / "convergence.png", "calibration of " + cases::name_of(c.variant),
+    plot = xy_lines(dir / "convergence.png", "calibration of " + c.variant.name,
                     "evaluation", "objective J", {all, best}, false, true)
                .filename()
                .string();
   }
   write_text_atomically(dir / "report.md", report_markdown(c, plot));
   write_text_atomically(dir / "calibration.json", calibration_json(c).dump(2) + "\n");
+  if (c.hand_back)
+    cases::write_network_with_coefficients(c.hand_back->original, dir / c.hand_back->file_name,
+                                           c.hand_back->stiffness, c.hand_back->damping);
   std::vector<std::string> overrides = c.calibrated_overrides;
-  std::string header = "# Calibrated by msfem calibrate (variant " + cases::name_of(c.variant) +
+  std::string header = "# Calibrated by msfem calibrate (variant " + c.variant.name +
                        ", git " + git_revision() + ") from " + c.problem.parameters.file.string() +
                        "\n";
   write_text_atomically(dir / "calibrated.prm",

@@ -333,8 +333,18 @@ fem_reference::Support tool_patch_support(const ToolPlacement& tool) {
 
 int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
                     const Eigen::Vector3d& direction) {
+  const Eigen::MatrixX3d from_centroid = surface.vertices.rowwise() - centroid.transpose();
+  const Eigen::VectorXd along = from_centroid * direction;
   Eigen::Index best = 0;
-  ((surface.vertices.rowwise() - centroid.transpose()) * direction).maxCoeff(&best);
+  const double farthest = along.maxCoeff(&best);
+  // On a flat face many vertices are as far (a box's side, a grid's end): the one nearest the
+  // line through the centroid, the middle of the face, rather than whichever comes first.
+  const double tie = 1e-12 * from_centroid.rowwise().norm().maxCoeff();
+  const auto off_line = [&](Eigen::Index v) {
+    return (from_centroid.row(v).transpose() - along[v] * direction).norm();
+  };
+  for (Eigen::Index v = 0; v < along.size(); ++v)
+    if (along[v] >= farthest - tie && off_line(v) < off_line(best) - tie) best = v;
   return static_cast<int>(best);
 }
 

@@ -168,7 +168,9 @@ struct ToolLoad {
 
 /// Defaults of `msfem calibrate` (each has a command-line option that overrides it).
 struct CalibrationParameters {
-  std::optional<Variant> variant;   ///< none: the first of mass spring/variants
+  /// A built-in variant's name or a network's NAME (mass spring/networks); none: the first of
+  /// mass spring/variants, else the first network.
+  std::optional<std::string> variant;
   std::vector<std::string> groups;  ///< spring groups to fit (empty: all of the variant's)
   std::vector<ToolLoad> train, test;
   double force_weight = 1.0;          ///< J = mean over loads of e_disp² + w e_force²

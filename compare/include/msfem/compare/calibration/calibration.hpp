@@ -97,6 +97,10 @@ struct CalibrationFit {
 /// Throws cases::InputError naming `problem.parameters.file` for an unknown group or an empty
 /// training set, std::runtime_error if a static solve fails.
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
+                         const VariantSpec& variant, const std::vector<CalibrationLoad>& train,
+                         const std::vector<CalibrationLoad>& test,
+                         const CalibrationOptions& options);
+CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
                          cases::Variant variant, const std::vector<CalibrationLoad>& train,
                          const std::vector<CalibrationLoad>& test,
                          const CalibrationOptions& options);

@@ -16,7 +16,7 @@ namespace msfem::compare {
 
 /// What the command line asks for; anything left unset comes from the case's calibration section.
 struct CalibrationRequest {
-  std::optional<cases::Variant> variant;
+  std::optional<std::string> variant;  ///< a built-in variant's name or a network's NAME
   std::optional<std::vector<std::string>> groups;
   std::optional<std::vector<cases::ToolLoad>> train, test;
   bool quiet = false;
@@ -34,10 +34,20 @@ struct VariantOnTest {
   double mean_reaction_force_rel_error = 0.0;
 };
 
+/// A fitted network as its simulator loads it: the user's file with the fitted groups' stiffness
+/// (and, where the file carries dampers, the damping of the fitted ratio) put in.
+struct NetworkHandBack {
+  std::filesystem::path original;
+  std::string file_name;  ///< calibrated_NAME and the original's extension
+  Eigen::VectorXd stiffness;
+  std::optional<Eigen::VectorXd> damping;
+};
+
 struct CaseCalibration {
   Problem problem;
   fem_reference::VolumeMesh mesh;
-  cases::Variant variant = cases::Variant::three_tier;
+  VariantSpec variant;
+  std::optional<NetworkHandBack> hand_back;  ///< set when the variant is a user's network
   CalibrationOptions options;
   double target_damping_ratio = 0.0;
   std::vector<CalibrationLoad> train, test;
@@ -64,7 +74,8 @@ CaseCalibration calibrate_case(const cases::CaseParameters& parameters,
 /// and the rest of what the report shows.
 nlohmann::json calibration_json(const CaseCalibration& c);
 
-/// Writes calibration.json, report.md, convergence.png (or .svg) and calibrated.prm into `dir`.
+/// Writes calibration.json, report.md, convergence.png (or .svg) and calibrated.prm into `dir`, and
+/// for a network calibrated_NAME.vtu (or the Xsp file's extension).
 void write_calibration_outputs(const CaseCalibration& c, const std::filesystem::path& dir);
 
 /// The before/after table printed by the command.

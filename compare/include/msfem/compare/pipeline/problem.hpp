@@ -65,8 +65,9 @@ cases::Surface source_surface(const cases::CaseParameters& parameters,
 /// fixed region or tool that catches no surface node, or a tool deeper than the model.
 Problem make_problem(const cases::CaseParameters& parameters);
 
-/// The surface vertex farthest from `centroid` along `direction`: where a tool presses or a patch
-/// force pulls.
+/// The surface vertex farthest from `centroid` along the unit `direction`: where a tool presses or
+/// a patch force pulls. Of vertices as far (a flat face) the one nearest the line through the
+/// centroid.
 int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
                     const Eigen::Vector3d& direction);
 
