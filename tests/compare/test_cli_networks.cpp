@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <string>
 
 #include "cli_runner.hpp"
@@ -168,6 +169,32 @@ TEST(CliNetworks, ANetworkOfAnotherGeometryIsRefusedNamingTheVertex) {
   EXPECT_NE(r.err.find("has no network node within"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("solving the FEM"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(tmp / "run"));
+}
+
+// A sweep re-meshes the case at each resolution, which a user's network cannot follow: the
+// network is swept at the case's own resolution only, equal there to the variant it came from,
+// and the sweep says so.
+TEST(CliNetworks, ASweepRunsANetworkAtTheCasesOwnResolutionOnlyAndSaysSo) {
+  TemporaryDirectory tmp;
+  const std::string bonded = cheap("sphere_indent_bonded.prm") +
+                             " --set 'mass spring/variants=three_tier'";
+  ASSERT_EQ(run_msfem("export-network " + bonded + " " + (tmp / "nets").string()).exit_code, 0);
+  const auto r = run_msfem("sweep " + bonded + " --quiet --resolutions 1,2 --integrators " +
+                           "symplectic_euler --set 'mass spring/networks=mine=" +
+                           (tmp / "nets" / "three_tier.vtu").string() + "' --out " +
+                           (tmp / "sweep").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto s = nlohmann::json::parse(read_text(tmp / "sweep" / "sweep.json"));
+  std::map<std::pair<std::string, int>, double> error;
+  for (const auto& p : s["points"])
+    error[{p["variant"], p["resolution"]}] = p["rel_l2_error"];
+  EXPECT_EQ(error.size(), 3u);  // three_tier at 1 and 2, mine at 2 only
+  ASSERT_TRUE(error.count({"mine", 2}));
+  expect_same(error[{"mine", 2}], error[{"three_tier", 2}], "mine at 2", 1e-10);
+  EXPECT_EQ(s["networks_at_own_resolution"]["resolution"], 2);
+  const std::string report = read_text(tmp / "sweep" / "report.md");
+  EXPECT_NE(report.find("networks mine swept at the case's own resolution 2 only"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -185,6 +185,7 @@ int sweep_command(const Arguments& args) {
     for (const auto& f : result.failed_variants)
       table += "\n> **" + f.model + " failed at resolution " + std::to_string(f.resolution) +
                "** and is left out of the table and plot: " + f.error + "\n";
+    if (result.networks) table += "\n> " + result.networks->note + ".\n";
     write_text_atomically(work / "report.md",
                           "# msfem sweep: " + parameters.name + "\n\n" + answer +
                               convergence_section(convergence) + "## Every configuration\n\n" +

@@ -173,6 +173,31 @@ std::vector<int> owners(
   return ranks::deal(cost);
 }
 
+// The resolution the case has as written: its icosphere level, its simplification target, or its
+// surface's vertex count.
+SweepResult::OwnResolution own_resolution(const cases::CaseParameters& p) {
+  SweepResult::OwnResolution own;
+  const std::string& source = p.geometry.source;
+  if (cases::is_surface_generator(source)) {
+    const auto first = source.find(':');
+    own.resolution = std::stoi(source.substr(first + 1));
+  } else if (p.geometry.simplify_to_vertices > 0) {
+    own.resolution = p.geometry.simplify_to_vertices;
+  } else {
+    std::vector<std::string> notes;
+    own.resolution = static_cast<int>(source_surface(p, notes).num_vertices());
+  }
+  std::string names;
+  for (const auto& n : p.mass_spring.networks) {
+    own.networks.push_back(n.name);
+    names += (names.empty() ? "" : ", ") + n.name;
+  }
+  own.note = "networks " + names + " swept at the case's own resolution " +
+             std::to_string(own.resolution) +
+             " only: msfem cannot re-mesh a user's network, nor refine it at the tool";
+  return own;
+}
+
 // One pass's settings beside the resolution: volume preservation and contact refinement.
 struct SweepPass {
   bool volume = false;
@@ -184,11 +209,10 @@ struct SweepPass {
 // volume-preserving pass: it would repeat the other's points). The FEM comes from the cache after
 // the first pass. Under mpirun the (variant, integrator) items are dealt out (owners) and timed at
 // the same time, one per rank: each timing is single-threaded on its rank's own core.
-std::vector<SweepPoint> sweep_resolution(const cases::CaseParameters& parameters, int resolution,
+std::vector<SweepPoint> sweep_resolution(cases::CaseParameters p, int resolution,
                                          const SweepSettings& settings, const SweepPass& pass,
                                          const std::filesystem::path& fem_cache_directory,
                                          std::vector<SweepResult::FailedVariant>& failed) {
-  cases::CaseParameters p = at_resolution(parameters, resolution);
   const bool volume = pass.volume;
   p.mass_spring.volume_preservation = volume;
   if (!settings.contact_refinement.empty()) {
@@ -254,14 +278,29 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   SweepResult result;
   std::vector<SweepPoint>& points = result.points;
   std::exception_ptr first_failure;
-  for (std::size_t r = 0; r < resolutions.size(); ++r) {
+  // The built-in variants at every resolution, then the networks at the case's own.
+  cases::CaseParameters builtin = parameters;
+  builtin.mass_spring.networks.clear();
+  std::vector<std::pair<int, cases::CaseParameters>> sweeps;
+  if (!builtin.mass_spring.variants.empty())
+    for (const int resolution : resolutions)
+      sweeps.emplace_back(resolution, at_resolution(builtin, resolution));
+  if (!parameters.mass_spring.networks.empty()) {
+    cases::CaseParameters networks = parameters;
+    networks.mass_spring.variants.clear();
+    result.networks = own_resolution(parameters);
+    sweeps.emplace_back(result.networks->resolution, networks);
+    progress.stage(result.networks->note);
+  }
+  for (std::size_t r = 0; r < sweeps.size(); ++r) {
+    const bool of_networks = sweeps[r].second.mass_spring.variants.empty();
     try {
       // All of a resolution's points or none of them.
       std::vector<SweepPoint> more;
       std::vector<SweepResult::FailedVariant> failed;
-      for (const SweepPass& pass : passes) {
-        const std::vector<SweepPoint> swept = sweep_resolution(parameters, resolutions[r], settings,
-                                                               pass, fem_cache_directory, failed);
+      for (const SweepPass& pass : of_networks ? std::vector<SweepPass>{{}} : passes) {
+        const std::vector<SweepPoint> swept = sweep_resolution(
+            sweeps[r].second, sweeps[r].first, settings, pass, fem_cache_directory, failed);
         more.insert(more.end(), swept.begin(), swept.end());
       }
       points.insert(points.end(), more.begin(), more.end());
@@ -271,12 +310,13 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
       result.failed_variants.insert(result.failed_variants.end(), failed.begin(), failed.end());
     } catch (const std::exception& e) {
       if (!first_failure) first_failure = std::current_exception();
-      result.failed_resolutions.emplace_back(resolutions[r], e.what());
-      progress.stage("sweep resolution " + std::to_string(resolutions[r]) + " failed: " + e.what());
+      result.failed_resolutions.emplace_back(sweeps[r].first, e.what());
+      progress.stage("sweep resolution " + std::to_string(sweeps[r].first) + " failed: " +
+                     e.what());
     }
     progress.advance(
-        "sweep resolution " + std::to_string(resolutions[r]), static_cast<int>(r + 1),
-        static_cast<int>(resolutions.size()),
+        "sweep resolution " + std::to_string(sweeps[r].first), static_cast<int>(r + 1),
+        static_cast<int>(sweeps.size()),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   // Nothing to show: the first failure as it was (bad input stays bad input).
@@ -301,7 +341,12 @@ nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepRe
           {"units", {{"length", "m"}, {"time", "s"}}},
           {"points", list},
           {"failed_resolutions", failed},
-          {"failed_variants", failed_variants}};
+          {"failed_variants", failed_variants},
+          {"networks_at_own_resolution",
+           result.networks ? nlohmann::json{{"resolution", result.networks->resolution},
+                                            {"networks", result.networks->networks},
+                                            {"note", result.networks->note}}
+                           : nlohmann::json(nullptr)}};
 }
 
 std::string sweep_table(const std::vector<SweepPoint>& points) {

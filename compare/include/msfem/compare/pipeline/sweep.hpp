@@ -63,6 +63,14 @@ struct SweepResult {
     std::string model, error;  ///< the model as SweepPoint::model() names it
   };
   std::vector<FailedVariant> failed_variants;
+  /// A user's networks (mass spring/networks) are of the case's own surface: msfem cannot re-mesh
+  /// them, so they are swept at that resolution only (and not in the other passes' settings).
+  struct OwnResolution {
+    int resolution = 0;  ///< the case's own icosphere level or surface vertex count
+    std::vector<std::string> networks;
+    std::string note;  ///< what the report and the command say
+  };
+  std::optional<OwnResolution> networks;
 };
 
 /// Runs the sweep (the FEM once per resolution, through the cache when given). Throws when no
