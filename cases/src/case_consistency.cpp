@@ -72,9 +72,9 @@ void check_geometry_unit(const GeometryParameters& geometry) {
 }
 
 void check_mass_spring(const MassSpringParameters& ms) {
-  if (ms.variants.empty() && ms.networks.empty())
+  if (ms.variants.empty() && ms.networks.empty() && ms.results.empty())
     throw InputError(
-        "mass spring/variants is empty and mass spring/networks names none: "
+        "mass spring/variants is empty and mass spring/networks and results name none: "
         "nothing to compare with the FEM");
   const auto& refinement = ms.contact_refinement;
   if (!refinement.enabled && (refinement.radius_m > 0 || refinement.edge_m > 0))

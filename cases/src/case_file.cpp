@@ -141,6 +141,9 @@ void declare_mass_spring(ParameterHandler& prm) {
                     "A user's own networks, NAME=FILE separated by ';' (.vtu, .vtk, .xs3; "
                     "relative to the case file), each compared as a variant named NAME "
                     "(docs/networks.md).");
+  prm.declare_entry("results", "", Patterns::Anything(),
+                    "An outside simulator's answers, NAME=FILE[,FILE...] separated by ';': one "
+                    "deformed surface per load (docs/external.md).");
   prm.declare_entry("stiffness model", "lloyd",
                     Patterns::Selection(selection_of<massspring::TetStiffnessRule>()),
                     "Analytic starting stiffness: Lloyd et al. 2007 or van Gelder 1998.");
@@ -434,6 +437,7 @@ void extract_mass_spring(ParameterHandler& prm, CaseParameters& c) {
   for (const auto& name : dealii::Utilities::split_string_list(prm.get("variants")))
     ms.variants.push_back(parse_setting<Variant>(name, "mass spring/variants"));
   ms.networks = parse_networks(prm.get("networks"));
+  ms.results = parse_results(prm.get("results"), ms.networks);
   ms.stiffness_model = setting<massspring::TetStiffnessRule>(prm, "stiffness model");
   ms.damping_ratio = prm.get_double("damping ratio");
   ms.group_scales =

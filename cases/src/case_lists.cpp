@@ -2,6 +2,8 @@
 // that an error names the entry at fault.
 #include "case_lists.hpp"
 
+#include <algorithm>
+
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -46,28 +48,58 @@ std::vector<std::pair<std::string, double>> parse_group_scales(
   return scales;
 }
 
-std::vector<MassSpringParameters::Network> parse_networks(const std::string& text) {
-  std::vector<MassSpringParameters::Network> networks;
-  std::set<std::string> names;
+// NAME=FILE[,FILE...] entries separated by ';' under `key`; a name is letters, digits and '_',
+// not a built-in variant's and not one of `taken`.
+std::vector<std::pair<std::string, std::vector<std::string>>> parse_named_files(
+    const std::string& text, const std::string& key, std::set<std::string> taken) {
+  std::vector<std::pair<std::string, std::vector<std::string>>> entries;
   std::istringstream in(text);
   for (std::string entry; std::getline(in, entry, ';');) {
     entry = trimmed(entry);
     if (entry.empty()) continue;
     const auto eq = entry.find('=');
     const std::string name = eq == std::string::npos ? "" : trimmed(entry.substr(0, eq));
-    const std::string file = eq == std::string::npos ? "" : trimmed(entry.substr(eq + 1));
-    if (!is_name(name) || file.empty())
-      throw InputError("mass spring/networks: '" + entry +
+    std::vector<std::string> files;
+    if (eq != std::string::npos) {
+      std::istringstream list(entry.substr(eq + 1));
+      for (std::string file; std::getline(list, file, ',');)
+        files.push_back(trimmed(file));
+    }
+    if (!is_name(name) || files.empty() ||
+        std::any_of(files.begin(), files.end(), [](const auto& f) { return f.empty(); }))
+      throw InputError(key + ": '" + entry +
                        "' is not NAME=FILE (NAME of letters, digits and '_')");
     for (const auto& builtin : names_of(Variant{}).entries)
       if (name == builtin.name)
-        throw InputError("mass spring/networks: '" + name +
-                         "' is a built-in variant's name; name the network otherwise");
-    if (!names.insert(name).second)
-      throw InputError("mass spring/networks: the name '" + name + "' is given twice");
-    networks.push_back({name, file});
+        throw InputError(key + ": '" + name +
+                         "' is a built-in variant's name; give it another name");
+    if (!taken.insert(name).second)
+      throw InputError(key + ": the name '" + name + "' is given twice");
+    entries.emplace_back(name, files);
+  }
+  return entries;
+}
+
+std::vector<MassSpringParameters::Network> parse_networks(const std::string& text) {
+  std::vector<MassSpringParameters::Network> networks;
+  for (const auto& [name, files] : parse_named_files(text, "mass spring/networks", {})) {
+    if (files.size() != 1)
+      throw InputError("mass spring/networks: " + name + " names " +
+                       std::to_string(files.size()) + " files; a network is one file");
+    networks.push_back({name, files.front()});
   }
   return networks;
+}
+
+std::vector<MassSpringParameters::Result> parse_results(
+    const std::string& text, const std::vector<MassSpringParameters::Network>& networks) {
+  std::set<std::string> taken;
+  for (const auto& n : networks)
+    taken.insert(n.name);
+  std::vector<MassSpringParameters::Result> results;
+  for (const auto& [name, files] : parse_named_files(text, "mass spring/results", taken))
+    results.push_back({name, {files.begin(), files.end()}});
+  return results;
 }
 
 }  // namespace msfem::cases

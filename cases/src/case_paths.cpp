@@ -17,6 +17,13 @@ void resolve_paths(CaseParameters& c) {
       throw InputError(c.file.string() + ": mass spring/networks: " + network.name + "=" +
                        network.file.string() + ": no such file");
   }
+  for (auto& result : c.mass_spring.results)
+    for (auto& file : result.files) {
+      if (file.is_relative()) file = (c.file.parent_path() / file).lexically_normal();
+      if (!std::filesystem::is_regular_file(file))
+        throw InputError(c.file.string() + ": mass spring/results: " + result.name + "=" +
+                         file.string() + ": no such file");
+    }
   // A relative surface path is relative to the case file, so cases run from any folder.
   if (is_image_source(c.geometry.source)) {
     try {

@@ -100,8 +100,8 @@ inline SofaBeam make_sofa_beam(SofaBeam b) {
 }
 
 /// The beam as ParaView or SOFA's VTKExporter writes an unstructured grid: line cells (springs)
-/// then triangle cells (the surface); cell data stiffness and group (the triangles' 0), point data
-/// mass and fixed; group names in field data.
+/// then triangle cells (the surface); cell data stiffness, damping (none) and group (the
+/// triangles' 0), point data mass and fixed; group names in field data.
 inline void write_sofa_beam_vtu(const SofaBeam& b, const std::filesystem::path& file) {
   std::ofstream out(file);
   out.precision(17);
@@ -124,6 +124,10 @@ inline void write_sofa_beam_vtu(const SofaBeam& b, const std::filesystem::path& 
   for (std::size_t s = 0; s < b.springs.size(); ++s)
     out << b.spring_stiffness(s) << "\n";
   for (std::size_t t = 0; t < b.triangles.size(); ++t)
+    out << "0\n";
+  // No dampers, as SOFA's MeshSpringForceField has by default and the Xsp file says (kd = 0).
+  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"damping\" format=\"ascii\">\n";
+  for (std::size_t c = 0; c < cells; ++c)
     out << "0\n";
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"group\" format=\"ascii\">\n";
   for (std::size_t s = 0; s < b.springs.size(); ++s)

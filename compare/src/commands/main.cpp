@@ -49,6 +49,11 @@ const std::vector<CommandEntry>& commands() {
        "          [--no-cache] [--quiet]\n"
        "      fit spring-group stiffness to the FEM on training loads (DX,DY,DZ@DEPTH;...), check\n"
        "      on held-out loads; calibration.json, report.md, calibrated.prm"},
+      {"export-load", export_load_command,
+       "export-load CASE.prm OUTDIR [--set K=V]...\n"
+       "      what an outside simulator needs to reproduce each load: surface.vtu (the case's\n"
+       "      surface, vertex_id, fixed) and loads.json (tools along their paths, gravity, patch\n"
+       "      forces, material); its answers come back as mass spring/results = NAME=FILE,..."},
       {"export-network", export_network_command,
        "export-network CASE.prm OUTDIR [--set K=V]...\n"
        "      every variant of the case as a network file a simulator loads: NAME.vtu (springs,\n"

@@ -9,6 +9,7 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
+#include "msfem/compare/pipeline/external_result.hpp"
 #include "msfem/compare/pipeline/fem_cache.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
@@ -148,34 +149,11 @@ bool lost_the_tool(const Eigen::Vector3d& force, const Eigen::Vector3d& fem_forc
 ToolLoadVariant compare_at_load(const Problem& problem, const BuiltVariant& built,
                                 const StaticSolution& s, std::vector<ForceDepthPoint> curve,
                                 const LoadReference& load) {
-  const FemSolution& fem = load.fem;
-  const std::optional<ToolPlacement>& tool = load.tool;
-  ToolLoadVariant o;
-  o.name = built.name;
-  o.errors = zoned_displacement_error(s.surface_displacement, fem.surface_displacement,
-                                      problem.surface.vertices, load.compared_vertices,
-                                      tool ? tool->contact_point : problem.centroid,
-                                      tool ? 2 * tool->radius : 0.0);
-  o.tool_force = s.tool_force;
-  if (tool) {
-    o.lost_tool = lost_the_tool(s.tool_force, fem.tool_force, *tool);
-    o.reaction_force_rel_error = reaction_force_rel_error(s.tool_force, fem.tool_force);
-  }
-  o.volume_change = volume_change(problem.surface, s.surface_displacement);
+  ToolLoadVariant o = measure_at_load(problem, built.name, s.surface_displacement, s.tool_force,
+                                      std::move(curve), load);
   o.inverted_elements = inverted_tetrahedra(built, s.x);
-  o.force_depth_monotone = force_grows_with_depth(curve, tool);
-  o.force_depth = std::move(curve);
-  const std::vector<int> patch = patch_vertices(problem);
-  if (!patch.empty()) {
-    const Eigen::Vector3d reference = mean_displacement(fem.surface_displacement, patch);
-    o.patch_mean_displacement = mean_displacement(s.surface_displacement, patch);
-    o.patch_displacement_rel_error =
-        (*o.patch_mean_displacement - reference).norm() / reference.norm();
-  }
   o.newton_iterations = s.newton_iterations;
   o.equilibrium = s.x;
-  o.surface_displacement = s.surface_displacement;
-  o.error = s.surface_displacement - fem.surface_displacement;
   return o;
 }
 
@@ -307,6 +285,39 @@ void run_variants(CaseRun& run, const std::vector<double>& path, const RunSettin
 
 }  // namespace
 
+ToolLoadVariant measure_at_load(const Problem& problem, const std::string& name,
+                                const Eigen::MatrixX3d& surface_displacement,
+                                const std::optional<Eigen::Vector3d>& tool_force,
+                                std::vector<ForceDepthPoint> curve, const LoadReference& load) {
+  const FemSolution& fem = load.fem;
+  const std::optional<ToolPlacement>& tool = load.tool;
+  ToolLoadVariant o;
+  o.name = name;
+  o.errors = zoned_displacement_error(surface_displacement, fem.surface_displacement,
+                                      problem.surface.vertices, load.compared_vertices,
+                                      tool ? tool->contact_point : problem.centroid,
+                                      tool ? 2 * tool->radius : 0.0);
+  o.force_measured = tool_force.has_value();
+  if (tool_force) o.tool_force = *tool_force;
+  if (tool && tool_force) {
+    o.lost_tool = lost_the_tool(*tool_force, fem.tool_force, *tool);
+    o.reaction_force_rel_error = reaction_force_rel_error(*tool_force, fem.tool_force);
+  }
+  o.volume_change = volume_change(problem.surface, surface_displacement);
+  o.force_depth_monotone = force_grows_with_depth(curve, tool);
+  o.force_depth = std::move(curve);
+  const std::vector<int> patch = patch_vertices(problem);
+  if (!patch.empty()) {
+    const Eigen::Vector3d reference = mean_displacement(fem.surface_displacement, patch);
+    o.patch_mean_displacement = mean_displacement(surface_displacement, patch);
+    o.patch_displacement_rel_error =
+        (*o.patch_mean_displacement - reference).norm() / reference.norm();
+  }
+  o.surface_displacement = surface_displacement;
+  o.error = surface_displacement - fem.surface_displacement;
+  return o;
+}
+
 StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& tool,
                      const std::vector<double>& path, std::vector<ForceDepthPoint>* curve) {
   if (!tool || path.empty()) {
@@ -410,6 +421,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   progress.stage("loading the surface and placing supports and loads");
   run.problem = make_problem(parameters);
   check_variants_fit(run.problem);
+  check_results_fit(run.problem);
   reference_at_every_load(run, settings, progress);
   const std::optional<ToolPlacement>& tool = run.loads.front().tool;
 
@@ -423,6 +435,8 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
     detail::run_variants_across_ranks(run, path, settings, progress);
   else
     run_variants(run, path, settings, progress);
+  for (VariantResult& v : external_variants(run))
+    run.variants.push_back(std::move(v));
   if (!settings.force_depth_curve)
     for (auto& v : run.variants)
       for (auto& load : v.loads)

@@ -188,10 +188,10 @@ SweepResult::OwnResolution own_resolution(const cases::CaseParameters& p) {
     own.resolution = static_cast<int>(source_surface(p, notes).num_vertices());
   }
   std::string names;
-  for (const auto& n : p.mass_spring.networks) {
+  for (const auto& n : p.mass_spring.networks)
     own.networks.push_back(n.name);
-    names += (names.empty() ? "" : ", ") + n.name;
-  }
+  for (const auto& name : own.networks)
+    names += (names.empty() ? "" : ", ") + name;
   own.note = "networks " + names + " swept at the case's own resolution " +
              std::to_string(own.resolution) +
              " only: msfem cannot re-mesh a user's network, nor refine it at the tool";
@@ -281,6 +281,7 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   // The built-in variants at every resolution, then the networks at the case's own.
   cases::CaseParameters builtin = parameters;
   builtin.mass_spring.networks.clear();
+  builtin.mass_spring.results.clear();
   std::vector<std::pair<int, cases::CaseParameters>> sweeps;
   if (!builtin.mass_spring.variants.empty())
     for (const int resolution : resolutions)
@@ -288,10 +289,14 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   if (!parameters.mass_spring.networks.empty()) {
     cases::CaseParameters networks = parameters;
     networks.mass_spring.variants.clear();
+    networks.mass_spring.results.clear();
     result.networks = own_resolution(parameters);
     sweeps.emplace_back(result.networks->resolution, networks);
     progress.stage(result.networks->note);
   }
+  if (!parameters.mass_spring.results.empty())
+    progress.stage("mass spring/results are not swept: an outside answer has one resolution and "
+                   "no speed msfem can measure (msfem run compares it)");
   for (std::size_t r = 0; r < sweeps.size(); ++r) {
     const bool of_networks = sweeps[r].second.mass_spring.variants.empty();
     try {

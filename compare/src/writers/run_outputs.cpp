@@ -88,6 +88,7 @@ std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::
     }
     series.push_back(fem);
     for (const auto& v : run.variants) {
+      if (v.loads.front().force_depth.empty()) continue;  // an outside answer without a curve
       Series s{v.name, {}, {}};
       for (const auto& p : v.loads.front().force_depth) {
         s.x.push_back(1e3 * p.depth_m);
@@ -123,13 +124,19 @@ std::string tool_positions_table(const CaseRun& run) {
     char cell[64];
     md << "| " << v.name << " |";
     for (const ToolLoadVariant& o : v.loads) {
-      std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
-                    o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
+      if (o.force_measured)
+        std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
+                      o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
+      else
+        std::snprintf(cell, sizeof cell, " %.3f / - |", o.errors.all.rel_l2_error);
       md << cell;
       l2 += o.errors.all.rel_l2_error;
       force += o.reaction_force_rel_error;
     }
-    std::snprintf(cell, sizeof cell, " %.3f / %.3f |", l2 / tools, force / tools);
+    if (std::all_of(v.loads.begin(), v.loads.end(), [](const auto& o) { return o.force_measured; }))
+      std::snprintf(cell, sizeof cell, " %.3f / %.3f |", l2 / tools, force / tools);
+    else
+      std::snprintf(cell, sizeof cell, " %.3f / - |", l2 / tools);
     md << cell << "\n";
   }
   md << "\nTool 0 is the load of the tables above; each other tool presses alone to the same depth "

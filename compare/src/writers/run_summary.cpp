@@ -91,8 +91,9 @@ nlohmann::json load_json(const CaseRun& run, std::size_t load, const ToolLoadVar
           {"mean_error_over_max_disp", e.all.mean_error_over_max_disp},
           {"contact_zone", zone(e.contact_zone)},
           {"far_field", zone(e.far_field)},
-          {"reaction_force_N", vec(o.tool_force)},
-          {"reaction_force_rel_error", o.reaction_force_rel_error},
+          {"reaction_force_N", o.force_measured ? vec(o.tool_force) : nlohmann::json()},
+          {"reaction_force_rel_error",
+           o.force_measured ? nlohmann::json(o.reaction_force_rel_error) : nlohmann::json()},
           {"volume_change", o.volume_change},
           {"inverted_elements", json_or_null(o.inverted_elements)},
           {"force_depth_monotone", json_or_null(o.force_depth_monotone)},
@@ -107,16 +108,19 @@ nlohmann::json load_json(const CaseRun& run, std::size_t load, const ToolLoadVar
 nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
   nlohmann::json list = nlohmann::json::array();
   double l2 = 0.0, force = 0.0;
+  bool every_force = true;
   const std::vector<ToolLoadVariant>& loads = v.loads;
   for (std::size_t t = 0; t < loads.size(); ++t) {
     list.push_back(load_json(run, t, loads[t]));
     l2 += loads[t].errors.all.rel_l2_error;
     force += loads[t].reaction_force_rel_error;
+    every_force = every_force && loads[t].force_measured;
   }
   const double n = static_cast<double>(loads.size());
   return {{"per_tool", list},
           {"mean_rel_l2_error", l2 / n},
-          {"mean_reaction_force_rel_error", force / n}};
+          {"mean_reaction_force_rel_error",
+           every_force ? nlohmann::json(force / n) : nlohmann::json()}};
 }
 
 std::string command_output(const std::string& command) {
@@ -217,7 +221,7 @@ nlohmann::json fem_json(const CaseRun& run) {
 nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
   const ToolLoadVariant& first = v.loads.front();
   const nlohmann::json fd = curve_json(first.force_depth);
-  const bool tool = run.loads.front().tool.has_value();
+  const bool tool = run.loads.front().tool.has_value() && first.force_measured;
   nlohmann::json j = {
       {"name", v.name},
       {"nodes", v.nodes},
@@ -385,7 +389,14 @@ std::string variant_table(const CaseRun& run) {
   for (const auto& v : run.variants) {
     // Not timed (--no-timing): dashes, not zeros that read as measurements.
     const bool timed = !v.timing.integrator.empty();
-    char steps[32] = "-", dt[32] = "-", frame[32] = "-", force[32] = "-";
+    char steps[32] = "-", dt[32] = "-", frame[32] = "-", force[32] = "-", springs[32] = "-";
+    if (v.external) {
+      std::snprintf(steps, sizeof steps, "external");
+      std::snprintf(dt, sizeof dt, "external");
+      std::snprintf(frame, sizeof frame, "external");
+    } else {
+      std::snprintf(springs, sizeof springs, "%d", v.springs);
+    }
     if (timed) {
       std::snprintf(steps, sizeof steps, "%.0f", v.timing.steps_per_second);
       std::snprintf(dt, sizeof dt, "%.3g", v.timing.stable_dt_s);
@@ -394,7 +405,9 @@ std::string variant_table(const CaseRun& run) {
     const ToolLoadVariant& own = v.loads.front();
     const std::vector<std::string> unresolved = unresolved_metrics(run, own, 0);
     std::string force_error = "-";
-    if (tool && own.lost_tool) {
+    if (tool && !own.force_measured) {
+      // An outside answer without a force: empty, never a zero.
+    } else if (tool && own.lost_tool) {
       std::snprintf(force, sizeof force, "lost");
       force_error = "lost";
     } else if (tool) {
@@ -403,8 +416,8 @@ std::string variant_table(const CaseRun& run) {
                                contains(unresolved, "reaction_force_rel_error"));
     }
     std::snprintf(
-        line, sizeof line, "| %-12s | %6d | %7d | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
-        v.name.c_str(), v.nodes, v.springs,
+        line, sizeof line, "| %-12s | %6d | %7s | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
+        v.name.c_str(), v.nodes, springs,
         error_cell(own.errors.all.rel_l2_error, contains(unresolved, "rel_l2_error")).c_str(),
         1e3 * own.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
     out << line;

@@ -133,6 +133,14 @@ struct MassSpringParameters {
     std::filesystem::path file;
   };
   std::vector<Network> networks;
+  /// An outside simulator's answers (`mass spring/results = NAME=FILE[,FILE...]; ...`): one
+  /// deformed surface per load of the case, in load order, compared as a variant named NAME
+  /// (docs/external.md).
+  struct Result {
+    std::string name;
+    std::vector<std::filesystem::path> files;
+  };
+  std::vector<Result> results;
 };
 
 struct FemParameters {

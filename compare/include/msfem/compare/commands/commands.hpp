@@ -22,6 +22,7 @@ int bench_command(const Arguments& args);    // msfem bench massspring|fem [--js
 int verify_command(const Arguments& args);   // msfem verify [--json]
 int regress_command(const Arguments& args);  // msfem regress [--baselines DIR] [CASE...] [--update]
 int export_network_command(const Arguments& args);  // msfem export-network CASE.prm OUTDIR
+int export_load_command(const Arguments& args);     // msfem export-load CASE.prm OUTDIR
 int calibrate_command(const Arguments& args);  // msfem calibrate CASE.prm [--variant V] [--fit G]
 
 }  // namespace msfem::compare

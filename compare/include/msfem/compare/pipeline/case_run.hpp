@@ -29,6 +29,8 @@ struct ToolLoadVariant {
   ZonedErrorMetrics errors;
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
   double reaction_force_rel_error = 0.0;
+  /// False for an outside simulator's answer that carries no force: the force columns are empty.
+  bool force_measured = true;
   double volume_change = 0.0;
   std::optional<int> inverted_elements;
   std::vector<ForceDepthPoint> force_depth;  ///< every step of its loading path
@@ -56,6 +58,8 @@ struct VariantResult {
   nlohmann::json parameters;                  ///< group stiffness, damping, masses as used
   std::vector<std::string> warnings;
   std::vector<ToolLoadVariant> loads;  ///< one per CaseRun::loads, in that order
+  /// An outside simulator's answer (mass spring/results): no network, nothing timed here.
+  bool external = false;
 };
 
 struct CaseRun {
@@ -99,6 +103,14 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
 StaticSolution press(BuiltVariant& built, const std::optional<ToolPlacement>& tool,
                      const std::vector<double>& path,
                      std::vector<ForceDepthPoint>* curve = nullptr);
+
+/// An answer at one load measured against the FEM there: the zoned displacement errors, the force
+/// and its error (when the answer has a force), the volume change, the patch's mean displacement,
+/// whether the force grows along `curve`.
+ToolLoadVariant measure_at_load(const Problem& problem, const std::string& name,
+                                const Eigen::MatrixX3d& surface_displacement,
+                                const std::optional<Eigen::Vector3d>& tool_force,
+                                std::vector<ForceDepthPoint> curve, const LoadReference& load);
 
 /// Force-depth depths of a tool: the case's list, or a quarter, half, three quarters and all of it.
 std::vector<double> curve_depths(const cases::ToolParameters& tool);
