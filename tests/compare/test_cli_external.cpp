@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -120,6 +121,37 @@ TEST_F(ExternalResults, TheFemsOwnAnswerHasNoErrorAndAVariantsOwnItsMetrics) {
   const std::string report = read_text(path("back") / "report.md");
   EXPECT_NE(report.find("| bare "), std::string::npos);
   EXPECT_NE(report.find("external"), std::string::npos);
+}
+
+// A second program (tests/compare/stand_in_simulator.cpp) that knows only export-load's files
+// builds msfem's single layer there and presses it: its answer, brought back, is measured as the
+// built-in single_layer is.
+TEST_F(ExternalResults, ASecondProgramsAnswerFromTheExportedLoadsIsMeasuredAsTheBuiltInOne) {
+  for (const char* mode : {"contact", "prescribed"}) {
+    const std::string name = mode;
+    const std::string setting = " --set loads/tool/mode=" + name;
+    ASSERT_EQ(run_msfem("export-load " + sphere + setting + " " + path("load_" + name).string())
+                  .exit_code,
+              0);
+    const std::string answer = path("stand_in_" + name + ".vtu").string();
+    ASSERT_EQ(std::system((std::string(MSFEM_STAND_IN_SIMULATOR) + " " +
+                           path("load_" + name).string() + " " + answer)
+                              .c_str()),
+              0);
+    const auto r = run_msfem("run " + sphere + setting +
+                             " --quiet --no-timing --set 'mass spring/variants=single_layer'"
+                             " --set 'mass spring/results=sim=" +
+                             answer + "' --out " + path("stand_in_run_" + name).string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto s =
+        nlohmann::json::parse(read_text(path("stand_in_run_" + name) / "summary.json"));
+    const auto& built = variant(s, "single_layer");
+    for (const char* metric :
+         {"rel_l2_error", "max_error_m", "reaction_force_rel_error", "volume_change"})
+      EXPECT_NEAR(variant(s, "sim")[metric].get<double>(), built[metric].get<double>(),
+                  1e-8 * std::abs(built[metric].get<double>()))
+          << mode << " " << metric;
+  }
 }
 
 TEST_F(ExternalResults, AnAnswerTenPercentWorseFailsRegress) {
