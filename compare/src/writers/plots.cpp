@@ -5,6 +5,8 @@
 
 #include "msfem/compare/writers/plots.hpp"
 
+#include "plot_render.hpp"
+
 #include "msfem/compare/writers/plot_labels.hpp"
 
 #include <fcntl.h>
@@ -148,32 +150,43 @@ void require_picture_name(const fs::path& path) {
     throw std::invalid_argument("plot '" + path.string() + "': the name must end in .png or .svg");
 }
 
-OutputFormat choose_format(const fs::path& requested) {
+OutputFormat choose_format(const fs::path& requested, int width, int height) {
+  const std::string size = std::to_string(width) + "," + std::to_string(height);
   const std::string svg =
-      "set terminal svg size 900,600 noenhanced font 'sans,12' background 'white'";
+      "set terminal svg size " + size + " noenhanced font 'sans,12' background 'white'";
   if (lowercase_extension(requested) == ".svg") return {requested, svg};
   if (gnuplot_has_pngcairo())
-    return {requested, "set terminal pngcairo size 900,600 noenhanced font 'sans,11'"};
+    return {requested, "set terminal pngcairo size " + size + " noenhanced font 'sans,11'"};
   return {fs::path(requested).replace_extension(".svg"), svg};
 }
 
-// Runs `commands` (which read the data file through the gnuplot variable `data`) and writes the
-// picture atomically. Returns the path written.
-fs::path render(const fs::path& requested, const std::string& data, const std::string& commands) {
+}  // namespace
+
+namespace detail {
+
+fs::path render(const fs::path& requested, const std::string& data, const std::string& commands,
+                int width, int height, const std::vector<std::string>& more_data) {
   require_picture_name(requested);
   if (!gnuplot_available())
     throw std::runtime_error("cannot draw '" + requested.string() +
                              "': gnuplot is not installed (Debian: gnuplot-nox)");
-  const OutputFormat format = choose_format(requested);
+  const OutputFormat format = choose_format(requested, width, height);
   ScratchDirectory scratch;
   const fs::path data_file = scratch.path() / "data.dat";
   const fs::path script_file = scratch.path() / "plot.gp";
   write_text_atomically(data_file, data);
+  std::string more_names;
+  for (std::size_t i = 0; i < more_data.size(); ++i) {
+    const fs::path file = scratch.path() / ("data" + std::to_string(i + 2) + ".dat");
+    write_text_atomically(file, more_data[i]);
+    more_names += "data" + std::to_string(i + 2) + " = " + quoted(file.string()) + "\n";
+  }
   write_file_atomically(format.path, [&](const fs::path& temporary) {
     std::ostringstream script;
     script << format.terminal << "\n"
            << "set output " << quoted(temporary.string()) << "\n"
            << "data = " << quoted(data_file.string()) << "\n"
+           << more_names
            << "set grid\nset key below\n"
            << commands << "unset output\n";
     write_text_atomically(script_file, script.str());
@@ -187,6 +200,12 @@ fs::path render(const fs::path& requested, const std::string& data, const std::s
   });
   return format.path;
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::render;
 
 std::string labels(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
   return "set title " + quoted(title) + "\nset xlabel " + quoted(xlabel) + "\nset ylabel " +

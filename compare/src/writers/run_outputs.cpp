@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/writers/error_picture.hpp"
 #include "msfem/compare/writers/fields_h5.hpp"
 #include "msfem/compare/writers/plots.hpp"
 #include "msfem/compare/writers/text_format.hpp"
@@ -59,13 +61,41 @@ void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
                   fem, variants);
 }
 
-// Plots are an addition to the numbers: without gnuplot the report says so instead.
-std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::path& dir) {
+// Each variant's deformed surface coloured by its error at the first load, one scale for all.
+std::vector<std::string> error_pictures(const CaseRun& run, const std::filesystem::path& dir) {
   std::vector<std::string> lines;
+  double max_mm = 0.0;
+  for (const auto& v : run.variants)
+    max_mm = std::max(max_mm, 1e3 * v.loads.front().error.rowwise().norm().maxCoeff());
+  std::optional<PictureTool> tool;
+  if (const auto& placed = run.loads.front().tool)
+    tool = PictureTool{placed->pushed_center(), placed->radius, placed->outward_normal};
+  for (const auto& v : run.variants) {
+    const ToolLoadVariant& first = v.loads.front();
+    const auto file =
+        error_picture(dir / ("error_" + v.name + ".png"), v.name + ": error on the organ",
+                      run.problem.surface.vertices + first.surface_displacement,
+                      run.problem.surface.triangles, 1e3 * first.error.rowwise().norm(), max_mm,
+                      tool);
+    lines.push_back("![" + v.name + ": error on the organ](" + file.filename().string() + ")");
+  }
+  return lines;
+}
+
+// The report's pictures: the error on the organ (beside the table) and the plots below.
+struct Plots {
+  std::vector<std::string> organ, other;
+};
+
+// Plots are an addition to the numbers: without gnuplot the report says so instead.
+Plots write_plots(const CaseRun& run, const std::filesystem::path& dir) {
+  Plots plots;
+  std::vector<std::string>& lines = plots.other;
   if (!gnuplot_available()) {
     lines.push_back("(plots skipped: gnuplot is not installed)");
-    return lines;
+    return plots;
   }
+  plots.organ = error_pictures(run, dir);
   std::vector<std::pair<std::string, Eigen::VectorXd>> histogram_series;
   const std::vector<int>& compared = run.loads.front().compared_vertices;
   for (const auto& v : run.variants) {
@@ -100,7 +130,7 @@ std::vector<std::string> write_plots(const CaseRun& run, const std::filesystem::
                                "depth (mm)", "|F| (N)", series, false, false);
     lines.push_back("![force-depth curve](" + file.filename().string() + ")");
   }
-  return lines;
+  return plots;
 }
 
 // Each tool position of the case as its own load: rel L2 and force error per variant, and means.
@@ -180,7 +210,7 @@ std::string youngs_modulus_text(const CaseRun& run) {
   return text;
 }
 
-std::string report_markdown(const CaseRun& run, const std::vector<std::string>& plots) {
+std::string report_markdown(const CaseRun& run, const Plots& plots) {
   const auto& p = run.problem.parameters;
   const LoadReference& first = run.loads.front();
   std::ostringstream md;
@@ -217,6 +247,13 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
         "|F − F_FEM|/|F_FEM|; steps/s of the `"
      << massspring::to_string(p.timing.integrator) << "` integrator (median after warm-up) on "
      << steppers_timed(run) << "; ms/frame = wall ms per 1/60 s of simulated time.\n\n";
+  if (!plots.organ.empty()) {
+    md << "### Where each variant is wrong\n\nThe deformed surface coloured by |u − u_FEM| on "
+          "one scale for every variant, along the tool and from the side (the tool's sphere "
+          "drawn as a circle).\n\n";
+    for (const auto& l : plots.organ)
+      md << l << "\n\n";
+  }
   md << "| variant | contact zone rel L2 | far field rel L2 | mean err / max disp | volume change "
         "| "
         "settle time s |\n|---|---|---|---|---|---|\n";
@@ -238,7 +275,7 @@ std::string report_markdown(const CaseRun& run, const std::vector<std::string>& 
   for (const auto& [name, why] : run.failed_variants)
     md << "\n> **" << name << " failed** and is left out of the tables and plots: " << why << "\n";
   md << "\n## Plots\n\n";
-  for (const auto& l : plots)
+  for (const auto& l : plots.other)
     md << l << "\n\n";
   md << "## Files\n\n- `summary.json`: every number above\n"
         "- `surfaces.pvd`: the surface of each variant with displacement, error vector and "
