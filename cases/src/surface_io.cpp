@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/x3d.hpp"
 #include "surface_io_detail.hpp"
 
 namespace msfem::cases {
@@ -244,8 +245,10 @@ SurfaceFormat surface_format_for(const fs::path& path) {
   if (extension == ".stl") return SurfaceFormat::stl;
   if (extension == ".off") return SurfaceFormat::off;
   if (extension == ".ply") return SurfaceFormat::ply;
+  if (extension == ".x3d") return SurfaceFormat::x3d;
   const std::string shown = extension.empty() ? "no extension" : "'" + extension + "'";
-  detail::fail(path, "unknown surface format " + shown + " (expected .obj, .stl, .off, .ply)");
+  detail::fail(path,
+               "unknown surface format " + shown + " (expected .obj, .stl, .off, .ply, .x3d)");
 }
 
 Surface read_surface(const fs::path& path, LengthUnit unit) {
@@ -265,6 +268,9 @@ Surface read_surface(const fs::path& path, LengthUnit unit) {
       break;
     case SurfaceFormat::ply:
       surface = detail::read_ply(path, data);
+      break;
+    case SurfaceFormat::x3d:
+      surface = read_x3d_surface_bytes(path, data);
       break;
   }
   if (surface.num_triangles() == 0) detail::fail(path, "no triangles");
@@ -293,6 +299,14 @@ void write_surface(const fs::path& path, const Surface& surface,
       break;
     case SurfaceFormat::ply:
       detail::write_ply(bytes, in_unit, unit_name, options.binary);
+      break;
+    case SurfaceFormat::x3d:
+      bytes = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<X3D profile=\"Interchange\" "
+              "version=\"3.3\">\n  <head>\n    <meta name=\"unit\" content=\"" +
+              unit_name + "\"/>\n  </head>\n  <Scene>\n" +
+              x3d_shape("surface", in_unit.vertices, in_unit.triangles, Eigen::MatrixX3d(), "",
+                        "    ") +
+              "  </Scene>\n</X3D>\n";
       break;
   }
   // Same folder, so the rename is atomic; the pid keeps concurrent writers apart.

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/x3d.hpp"
 
 namespace msfem::cases {
 namespace {
@@ -168,7 +169,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Format{"obj", ".obj", false, true}, Format{"stl_ascii", ".stl", false, true},
                       Format{"stl_binary", ".stl", true, false}, Format{"off", ".off", false, true},
                       Format{"ply_ascii", ".ply", false, true},
-                      Format{"ply_binary", ".ply", true, true}),
+                      Format{"ply_binary", ".ply", true, true}, Format{"x3d", ".x3d", false, true}),
     [](const ::testing::TestParamInfo<Format>& info) { return info.param.name; });
 
 // ---- units ----
@@ -338,7 +339,7 @@ TEST_F(SurfaceIo, ExtensionsAreCaseInsensitive) {
 
 TEST_F(SurfaceIo, UnknownExtensionAndMissingFile) {
   expect_read_error(write_file("points.xyz", "1 2 3\n"),
-                    {"unknown surface format '.xyz'", "(expected .obj, .stl, .off, .ply)"});
+                    {"unknown surface format '.xyz'", "(expected .obj, .stl, .off, .ply, .x3d)"});
   expect_read_error(file("absent.obj"), {"cannot open", "No such file"});
   expect_read_error(write_file("empty.obj", ""), {"empty file"});
   expect_read_error(write_file("no_faces.obj", "v 0 0 0\n"), {"no triangles"});
@@ -417,6 +418,36 @@ TEST_F(SurfaceIo, BadOff) {
                     {"e.off:6:", "needs at least 3"});
   expect_read_error(write_file("f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n"),
                     {"f.off:6:", "2 of 3 vertex indices"});
+}
+
+// An X3D IndexedFaceSet as the layered brain paper's scene has it: commas between points, polygons
+// fan-triangulated, the last face without its -1, the Shape chosen by DEF; every fault named.
+TEST_F(SurfaceIo, X3dFaceSetsByDefWithPolygonsAndFaults) {
+  const std::string square =
+      "<X3D version=\"3.3\"><Scene><Shape DEF=\"other\"><IndexedFaceSet coordIndex=\"0 1 2\">"
+      "<Coordinate point=\"0 0 0, 1 0 0, 0 1 0\"/></IndexedFaceSet></Shape>"
+      "<Transform><Shape DEF=\"quad\"><IndexedFaceSet coordIndex=\"0 1 2 3 -1 0 3 2\">"
+      "<Coordinate point=\"0 0 0, 0.1 0 0, 0.1 0.1 0, 0 0.1 0\"/></IndexedFaceSet></Shape>"
+      "</Transform></Scene></X3D>";
+  const fs::path path = write_file("scene.x3d", square);
+  const Surface quad = read_x3d_surface(path, "quad");
+  EXPECT_EQ(quad.num_vertices(), 4);
+  ASSERT_EQ(quad.num_triangles(), 3);  // the quad's two and the last face's one
+  EXPECT_EQ(quad.triangles.row(1), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(read_x3d_surface(path).num_vertices(), 3);  // the first face set
+  const std::string head = "<X3D><Scene><Shape><IndexedFaceSet coordIndex=\"";
+  expect_read_error(write_file("a.x3d", "<X3D><Scene>"), {"a.x3d: not XML"});
+  expect_read_error(write_file("b.x3d", "<X3D><Scene/></X3D>"), {"b.x3d: no IndexedFaceSet"});
+  expect_read_error(write_file("c.x3d", head + "0 1 3\"><Coordinate point=\"0 0 0 1 0 0 0 1 0\"/>"
+                                               "</IndexedFaceSet></Shape></Scene></X3D>"),
+                    {"c.x3d: coordIndex face 0: index 3 out of range (3 points)"});
+  expect_read_error(write_file("d.x3d", head + "0 1 2\"><Coordinate point=\"0 0 0 1 nan 0 0 1 0\"/>"
+                                               "</IndexedFaceSet></Shape></Scene></X3D>"),
+                    {"d.x3d: Coordinate point 1:", "not a finite number"});
+  expect_read_error(write_file("e.x3d", head + "0 1 -1\"><Coordinate point=\"0 0 0 1 0 0 0 1 0\"/>"
+                                               "</IndexedFaceSet></Shape></Scene></X3D>"),
+                    {"e.x3d: coordIndex face 0 has 2 corners"});
+  EXPECT_THROW(read_x3d_surface(path, "none"), InputError);
 }
 
 TEST_F(SurfaceIo, BadPly) {

@@ -1,7 +1,6 @@
 // The error drawn on the organ: a known error field on the icosphere, drawn as msfem run draws each
 // variant's, read back pixel by pixel (the PNG decoded here with zlib).
 #include <gtest/gtest.h>
-#include <zlib.h>
 
 #include <cstdint>
 #include <fstream>
@@ -10,84 +9,13 @@
 #include <vector>
 
 #include "cli_runner.hpp"
+#include "png_reader.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/compare/writers/error_picture.hpp"
 #include "msfem/compare/writers/plots.hpp"
 
 namespace msfem {
 namespace {
-
-struct Image {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> rgb;  ///< row-major, 3 bytes per pixel
-  std::array<int, 3> at(int column, int row) const {
-    const std::size_t i = 3 * (std::size_t(row) * std::size_t(width) + std::size_t(column));
-    return {{rgb[i], rgb[i + 1], rgb[i + 2]}};
-  }
-};
-
-std::uint32_t big_endian(const std::string& s, std::size_t at) {
-  return (std::uint32_t(std::uint8_t(s[at])) << 24) | (std::uint32_t(std::uint8_t(s[at + 1])) << 16) |
-         (std::uint32_t(std::uint8_t(s[at + 2])) << 8) | std::uint32_t(std::uint8_t(s[at + 3]));
-}
-
-// An 8-bit, non-interlaced RGB or RGBA PNG (what cairo writes): its chunks, IDAT inflated, each
-// row's filter undone (PNG specification, section 9).
-Image read_png(const std::filesystem::path& file) {
-  const std::string bytes = testing::read_text(file);
-  Image image;
-  if (bytes.size() < 8 || bytes.compare(1, 3, "PNG") != 0) {
-    ADD_FAILURE() << file << " is not a PNG";
-    return image;
-  }
-  std::string compressed;
-  int channels = 0;
-  for (std::size_t at = 8; at + 8 <= bytes.size();) {
-    const std::uint32_t length = big_endian(bytes, at);
-    const std::string type = bytes.substr(at + 4, 4);
-    if (type == "IHDR") {
-      image.width = int(big_endian(bytes, at + 8));
-      image.height = int(big_endian(bytes, at + 12));
-      EXPECT_EQ(bytes[at + 16], 8) << "bit depth";
-      channels = bytes[at + 17] == 6 ? 4 : 3;
-      EXPECT_EQ(bytes[at + 20], 0) << "interlaced";
-    } else if (type == "IDAT") {
-      compressed += bytes.substr(at + 8, length);
-    }
-    at += 12 + length;
-  }
-  const std::size_t stride = std::size_t(image.width) * std::size_t(channels);
-  std::vector<std::uint8_t> raw((stride + 1) * std::size_t(image.height));
-  uLongf size = raw.size();
-  EXPECT_EQ(uncompress(raw.data(), &size, reinterpret_cast<const Bytef*>(compressed.data()),
-                       compressed.size()),
-            Z_OK);
-  std::vector<std::uint8_t> pixels(stride * std::size_t(image.height));
-  for (int row = 0; row < image.height; ++row) {
-    const std::uint8_t filter = raw[std::size_t(row) * (stride + 1)];
-    const std::uint8_t* in = &raw[std::size_t(row) * (stride + 1) + 1];
-    std::uint8_t* out = &pixels[std::size_t(row) * stride];
-    const std::uint8_t* above = row > 0 ? out - stride : nullptr;
-    for (std::size_t i = 0; i < stride; ++i) {
-      const int a = i >= std::size_t(channels) ? out[i - channels] : 0;
-      const int b = above ? above[i] : 0;
-      const int c = above && i >= std::size_t(channels) ? above[i - channels] : 0;
-      int predictor = 0;
-      if (filter == 1) predictor = a;
-      if (filter == 2) predictor = b;
-      if (filter == 3) predictor = (a + b) / 2;
-      if (filter == 4) {
-        const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
-        predictor = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
-      }
-      out[i] = std::uint8_t(in[i] + predictor);
-    }
-  }
-  for (std::size_t p = 0; p < std::size_t(image.width) * std::size_t(image.height); ++p)
-    for (int k = 0; k < 3; ++k)
-      image.rgb.push_back(pixels[p * std::size_t(channels) + std::size_t(k)]);
-  return image;
-}
 
 TEST(ErrorPicture, TheToolsPixelHasTheColourOfTheLargestError) {
   if (!compare::gnuplot_available()) GTEST_SKIP() << "gnuplot is not installed";
@@ -106,7 +34,7 @@ TEST(ErrorPicture, TheToolsPixelHasTheColourOfTheLargestError) {
   testing::TemporaryDirectory dir;
   const auto file = compare::error_picture(dir / "error.png", "known field", ball.vertices,
                                            ball.triangles, error, 5.0, tool);
-  const Image image = read_png(file);
+  const testing::Image image = testing::read_png(file);
   EXPECT_EQ(image.width, compare::error_picture_width);
   EXPECT_EQ(image.height, compare::error_picture_height);
   std::set<std::array<int, 3>> colours;

@@ -1,6 +1,7 @@
 #include "msfem/compare/writers/error_picture.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -19,12 +20,23 @@ struct Panel {
 constexpr Panel along_panel{0.03, 0.43}, side_panel{0.48, 0.88};
 constexpr double panel_bottom = 0.08, panel_top = 0.88;
 
-// A camera: the organ seen looking along -depth, `right` across and `up` up (right × up = depth,
-// so the picture is not mirrored).
-struct Camera {
-  Eigen::Vector3d right, up, depth;
-  Eigen::Vector3d focus;  ///< drawn at the panel's middle
-};
+// The scale's stops, shared by the pictures (gnuplot's palette) and the X3D scene's colours.
+constexpr double stops[5][4] = {{0.00, 0x44, 0x01, 0x54},
+                                {0.25, 0x3b, 0x52, 0x8b},
+                                {0.50, 0x21, 0x91, 0x8c},
+                                {0.75, 0x5e, 0xc9, 0x62},
+                                {1.00, 0xfd, 0xe7, 0x25}};
+
+std::string gnuplot_palette() {
+  std::string text = "set palette defined (";
+  char entry[48];
+  for (int i = 0; i < 5; ++i) {
+    std::snprintf(entry, sizeof entry, "%s%.2f '#%02x%02x%02x'", i ? ", " : "", stops[i][0],
+                  int(stops[i][1]), int(stops[i][2]), int(stops[i][3]));
+    text += entry;
+  }
+  return text + ")\n";
+}
 
 Eigen::Vector3d any_perpendicular(const Eigen::Vector3d& n) {
   const Eigen::Vector3d other =
@@ -48,13 +60,8 @@ std::string quoted(const std::string& text) {
 // The triangles in camera coordinates, each as a pm3d patch of two scans (a b / c c) with its
 // colour value, blocks separated by two blank lines.
 std::string patches(const Eigen::MatrixX3d& x, const Eigen::MatrixX3i& triangles,
-                    const Eigen::VectorXd& error_mm, const Camera& camera, double& half_width) {
+                    const Eigen::VectorXd& error_mm, const View& camera) {
   std::ostringstream out;
-  half_width = 0.0;
-  for (Eigen::Index v = 0; v < x.rows(); ++v) {
-    const Eigen::Vector3d d = x.row(v).transpose() - camera.focus;
-    half_width = std::max({half_width, std::abs(d.dot(camera.right)), std::abs(d.dot(camera.up))});
-  }
   auto point = [&](int v, double value) {
     const Eigen::Vector3d d = x.row(v).transpose() - camera.focus;
     // pm3d's depth order in a map view draws the largest z first: nearer is lower z.
@@ -74,14 +81,15 @@ std::string patches(const Eigen::MatrixX3d& x, const Eigen::MatrixX3i& triangles
   return out.str();
 }
 
-std::string panel_commands(const Panel& panel, const std::string& title, const Camera& camera,
-                           double half_width, const std::optional<PictureTool>& tool,
+std::string panel_commands(const Panel& panel, const std::string& title, const View& camera,
+                           const std::optional<PictureTool>& tool,
                            const char* data, bool colour_bar) {
   std::ostringstream c;
   c << "set lmargin at screen " << panel.left << "\nset rmargin at screen " << panel.right
     << "\nset tmargin at screen " << panel_top << "\nset bmargin at screen " << panel_bottom
-    << "\nset title " << quoted(title) << "\nset xrange [" << -half_width << ":" << half_width
-    << "]\nset yrange [" << -half_width << ":" << half_width << "]\nunset object\n";
+    << "\nset title " << quoted(title) << "\nset xrange [" << -camera.half_width << ":"
+    << camera.half_width << "]\nset yrange [" << -camera.half_width << ":" << camera.half_width
+    << "]\nunset object\n";
   if (tool) {
     const Eigen::Vector3d d = tool->center - camera.focus;
     c << "set object 1 circle at " << number(d.dot(camera.right)) << ","
@@ -95,6 +103,51 @@ std::string panel_commands(const Panel& panel, const std::string& title, const C
 }
 
 }  // namespace
+
+Eigen::Vector3d error_colour(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  int i = 0;
+  while (i < 3 && t > stops[i + 1][0])
+    ++i;
+  const double s = (t - stops[i][0]) / (stops[i + 1][0] - stops[i][0]);
+  Eigen::Vector3d rgb;
+  for (int k = 0; k < 3; ++k)
+    rgb[k] = ((1 - s) * stops[i][k + 1] + s * stops[i + 1][k + 1]) / 255.0;
+  return rgb;
+}
+
+std::array<View, 2> organ_views(const Eigen::MatrixX3d& deformed,
+                                const std::optional<PictureTool>& tool) {
+  View along, side;
+  if (tool) {
+    const Eigen::Vector3d n = tool->axis.normalized();
+    const Eigen::Vector3d u = any_perpendicular(n);
+    along = {"along the tool", u, n.cross(u), n, tool->center, 0.0};
+    // From the side the organ hangs below the tool: the middle of both is the view's middle.
+    side = {"from the side (tool axis up)", n.cross(u), n, u, tool->center, 0.0};
+    double low = 0.0, high = 0.0;
+    for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
+      const double up = (deformed.row(v).transpose() - tool->center).dot(n);
+      low = std::min(low, up), high = std::max(high, up);
+    }
+    side.focus += 0.5 * (low + high) * n;
+  } else {
+    const Eigen::Vector3d centre = deformed.colwise().mean().transpose();
+    along = {"from +z", Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+             Eigen::Vector3d::UnitZ(), centre, 0.0};
+    side = {"from +x", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
+            Eigen::Vector3d::UnitX(), centre, 0.0};
+  }
+  for (View* view : {&along, &side}) {
+    for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
+      const Eigen::Vector3d d = deformed.row(v).transpose() - view->focus;
+      view->half_width = std::max(
+          {view->half_width, std::abs(d.dot(view->right)), std::abs(d.dot(view->up))});
+    }
+    view->half_width *= 1.05;
+  }
+  return {along, side};
+}
 
 std::pair<int, int> error_picture_tool_pixel() {
   const double column = 0.5 * (along_panel.left + along_panel.right) * error_picture_width;
@@ -115,39 +168,18 @@ std::filesystem::path error_picture(const std::filesystem::path& path, const std
     throw std::invalid_argument("error picture '" + path.string() + "': a value is not finite");
   if (triangles.size() > 0 && (triangles.minCoeff() < 0 || triangles.maxCoeff() >= deformed.rows()))
     throw std::invalid_argument("error picture '" + path.string() + "': a vertex out of range");
-  Camera along, side;
-  if (tool) {
-    const Eigen::Vector3d n = tool->axis.normalized();
-    const Eigen::Vector3d u = any_perpendicular(n);
-    along = {u, n.cross(u), n, tool->center};
-    // From the side the organ hangs below the tool: the middle of both is the panel's middle.
-    side = {n.cross(u), n, u, tool->center};
-    double low = 0.0, high = 0.0;
-    for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
-      const double up = (deformed.row(v).transpose() - tool->center).dot(n);
-      low = std::min(low, up), high = std::max(high, up);
-    }
-    side.focus += 0.5 * (low + high) * n;
-  } else {
-    const Eigen::Vector3d centre = deformed.colwise().mean().transpose();
-    along = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), centre};
-    side = {Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(), centre};
-  }
-  double half_along = 0.0, half_side = 0.0;
-  const std::string along_data = patches(deformed, triangles, error_mm, along, half_along);
-  const std::string side_data = patches(deformed, triangles, error_mm, side, half_side);
+  const std::array<View, 2> views = organ_views(deformed, tool);
+  const std::string along_data = patches(deformed, triangles, error_mm, views[0]);
+  const std::string side_data = patches(deformed, triangles, error_mm, views[1]);
   const double top = max_mm > 0 ? max_mm : 1.0;  // no error anywhere: one colour, a scale to 1
   std::ostringstream c;
   c << "unset grid\nunset key\nset view map\nset pm3d depthorder\nset pm3d corners2color c1\n"
     << "unset xtics\nunset ytics\nunset ztics\nunset border\n"
-    << "set palette defined (0 '#440154', 0.25 '#3b528b', 0.5 '#21918c', 0.75 '#5ec962', "
-       "1 '#fde725')\n"
+    << gnuplot_palette()
     << "set cbrange [0:" << number(top) << "]\nset cblabel 'error |u - u_FEM| (mm)'\n"
     << "set multiplot title " << quoted(title) << "\n"
-    << panel_commands(along_panel, tool ? "along the tool" : "from +z", along, 1.05 * half_along,
-                      tool, "data", false)
-    << panel_commands(side_panel, tool ? "from the side (tool axis up)" : "from +x", side,
-                      1.05 * half_side, tool, "data2", true)
+    << panel_commands(along_panel, views[0].name, views[0], tool, "data", false)
+    << panel_commands(side_panel, views[1].name, views[1], tool, "data2", true)
     << "unset multiplot\n";
   return detail::render(path, along_data, c.str(), error_picture_width, error_picture_height,
                         {side_data});

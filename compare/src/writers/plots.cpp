@@ -226,13 +226,21 @@ void require_plottable(const std::string& series, const std::vector<double>& val
 
 }  // namespace
 
+std::string variant_colour(std::size_t i) {
+  // Okabe and Ito's colour-blind-safe set, then Tableau's.
+  static const char* const colours[] = {"#0072b2", "#e69f00", "#009e73", "#d55e00", "#cc79a7",
+                                        "#56b4e9", "#f0e442", "#8c564b", "#7f7f7f", "#bcbd22"};
+  return colours[i % (sizeof colours / sizeof *colours)];
+}
+
 bool gnuplot_available() {
   static const bool available = run_gnuplot({"--version"}).exit_status == 0;
   return available;
 }
 
 fs::path histogram(const fs::path& path, const std::string& title, const std::string& xlabel,
-                   const std::vector<std::pair<std::string, Eigen::VectorXd>>& series, int bins) {
+                   const std::vector<std::pair<std::string, Eigen::VectorXd>>& series, int bins,
+                   const std::vector<std::string>& colours) {
   if (series.empty()) throw std::invalid_argument("histogram '" + title + "': no series");
   if (bins < 1) throw std::invalid_argument("histogram '" + title + "': bins must be >= 1");
   double low = INFINITY, high = -INFINITY;
@@ -265,7 +273,9 @@ fs::path histogram(const fs::path& path, const std::string& title, const std::st
   commands << labels(title, xlabel, "count") << "set yrange [0:*]\nplot ";
   for (std::size_t i = 0; i < series.size(); ++i)
     commands << (i ? ", \\\n     " : "") << "data index " << i
-             << " using 1:2 with steps lw 2 title " << quoted(series[i].first);
+             << " using 1:2 with steps lw 2"
+             << (i < colours.size() ? " lc rgb " + quoted(colours[i]) : "") << " title "
+             << quoted(series[i].first);
   commands << "\n";
   return render(path, data.str(), commands.str());
 }
@@ -291,7 +301,9 @@ fs::path xy_lines(const fs::path& path, const std::string& title, const std::str
            << (logy ? "set logscale y\n" : "") << "plot ";
   for (std::size_t i = 0; i < series.size(); ++i)
     commands << (i ? ", \\\n     " : "") << "data index " << i
-             << " using 1:2 with linespoints lw 2 pt 7 ps 0.7 title " << quoted(series[i].name);
+             << " using 1:2 with linespoints lw 2 pt 7 ps 0.7"
+             << (series[i].colour.empty() ? "" : " lc rgb " + quoted(series[i].colour))
+             << " title " << quoted(series[i].name);
   commands << "\n";
   return render(path, data.str(), commands.str());
 }

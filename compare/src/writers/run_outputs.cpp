@@ -15,6 +15,7 @@
 #include "msfem/compare/writers/plots.hpp"
 #include "msfem/compare/writers/text_format.hpp"
 #include "msfem/compare/writers/vtu.hpp"
+#include "msfem/compare/writers/x3d_scene.hpp"
 #include "msfem/fem_reference/elasticity_problem.hpp"
 
 namespace msfem::compare {
@@ -61,15 +62,36 @@ void write_fields(const CaseRun& run, const std::filesystem::path& dir) {
                   fem, variants);
 }
 
-// Each variant's deformed surface coloured by its error at the first load, one scale for all.
-std::vector<std::string> error_pictures(const CaseRun& run, const std::filesystem::path& dir) {
-  std::vector<std::string> lines;
+// The largest error of any variant at the first load (mm), the one scale the pictures and the
+// scene colour by, and the tool as they draw it.
+double largest_error_mm(const CaseRun& run) {
   double max_mm = 0.0;
   for (const auto& v : run.variants)
     max_mm = std::max(max_mm, 1e3 * v.loads.front().error.rowwise().norm().maxCoeff());
-  std::optional<PictureTool> tool;
+  return max_mm;
+}
+std::optional<PictureTool> picture_tool(const CaseRun& run) {
   if (const auto& placed = run.loads.front().tool)
-    tool = PictureTool{placed->pushed_center(), placed->radius, placed->outward_normal};
+    return PictureTool{placed->pushed_center(), placed->radius, placed->outward_normal};
+  return std::nullopt;
+}
+
+// The undeformed surface and each variant's deformed one with its error, as scene.x3d/.html.
+void write_scene(const CaseRun& run, const std::filesystem::path& dir) {
+  const cases::Surface& s = run.problem.surface;
+  std::vector<SceneSurface> surfaces{{"undeformed", s.vertices, std::nullopt}};
+  for (const auto& v : run.variants)
+    surfaces.push_back({v.name, s.vertices + v.loads.front().surface_displacement,
+                        Eigen::VectorXd(1e3 * v.loads.front().error.rowwise().norm())});
+  write_x3d_scene(dir, "msfem run: " + run.problem.parameters.name, s.triangles, surfaces,
+                  largest_error_mm(run), picture_tool(run));
+}
+
+// Each variant's deformed surface coloured by its error at the first load, one scale for all.
+std::vector<std::string> error_pictures(const CaseRun& run, const std::filesystem::path& dir) {
+  std::vector<std::string> lines;
+  const double max_mm = largest_error_mm(run);
+  const std::optional<PictureTool> tool = picture_tool(run);
   for (const auto& v : run.variants) {
     const ToolLoadVariant& first = v.loads.front();
     const auto file =
@@ -97,8 +119,10 @@ Plots write_plots(const CaseRun& run, const std::filesystem::path& dir) {
   }
   plots.organ = error_pictures(run, dir);
   std::vector<std::pair<std::string, Eigen::VectorXd>> histogram_series;
+  std::vector<std::string> colours;
   const std::vector<int>& compared = run.loads.front().compared_vertices;
   for (const auto& v : run.variants) {
+    colours.push_back(variant_colour(colours.size()));
     Eigen::VectorXd e(compared.size());
     for (std::size_t i = 0; i < compared.size(); ++i)
       e[i] = 1e3 * v.loads.front().error.row(compared[i]).norm();
@@ -106,20 +130,21 @@ Plots write_plots(const CaseRun& run, const std::filesystem::path& dir) {
   }
   if (!histogram_series.empty()) {
     const auto file = histogram(dir / "error_histogram.png", "Surface error magnitude per variant",
-                                "|u - u_FEM| (mm)", histogram_series, 30);
+                                "|u - u_FEM| (mm)", histogram_series, 30, colours);
     lines.push_back("![error histogram](" + file.filename().string() + ")");
   }
   if (!run.loads.front().force_depth.empty()) {
     std::vector<Series> series;
-    Series fem{"FEM", {}, {}};
+    Series fem{"FEM", {}, {}, "#000000"};
     for (const auto& p : run.loads.front().force_depth) {
       fem.x.push_back(1e3 * p.depth_m);
       fem.y.push_back(p.force_n.norm());
     }
     series.push_back(fem);
-    for (const auto& v : run.variants) {
+    for (std::size_t i = 0; i < run.variants.size(); ++i) {
+      const VariantResult& v = run.variants[i];
       if (v.loads.front().force_depth.empty()) continue;  // an outside answer without a curve
-      Series s{v.name, {}, {}};
+      Series s{v.name, {}, {}, variant_colour(i)};
       for (const auto& p : v.loads.front().force_depth) {
         s.x.push_back(1e3 * p.depth_m);
         s.y.push_back(p.force_n.norm());
@@ -281,7 +306,9 @@ std::string report_markdown(const CaseRun& run, const Plots& plots) {
         "- `surfaces.pvd`: the surface of each variant with displacement, error vector and "
         "magnitude (ParaView)\n- `fem.pvd`: the FEM solution\n"
         "- `fem.xdmf` + `fem.h5`: the FEM solution for XDMF readers (ParaView, VisIt, h5py)\n"
-        "- `fields.h5`: FEM volume field, per-variant surface displacement and error\n";
+        "- `fields.h5`: FEM volume field, per-variant surface displacement and error\n"
+        "- `scene.x3d`: the undeformed surface, each variant's deformed one in its error colours "
+        "and the tool (X3D 3.3); `scene.html` shows it in a browser (X3DOM, beside it)\n";
   return md.str();
 }
 
@@ -290,6 +317,7 @@ std::string report_markdown(const CaseRun& run, const Plots& plots) {
 void write_run_outputs(const CaseRun& run, const std::filesystem::path& directory) {
   write_surfaces(run, directory);
   write_fields(run, directory);
+  write_scene(run, directory);
   const auto plots = write_plots(run, directory);
   write_text_atomically(directory / "report.md", report_markdown(run, plots));
   write_text_atomically(directory / "summary.json", summary_json(run).dump(2) + "\n");

@@ -8,8 +8,9 @@
 
 namespace msfem::cases {
 
-/// File formats for closed surfaces, chosen by extension (.obj, .stl, .off, .ply).
-enum class SurfaceFormat { obj, stl, off, ply };
+/// File formats for closed surfaces, chosen by extension (.obj, .stl, .off, .ply, .x3d: the
+/// file's first IndexedFaceSet, cases/x3d.hpp).
+enum class SurfaceFormat { obj, stl, off, ply, x3d };
 
 /// The format for a path's extension (case-insensitive); throws InputError naming the file for an
 /// unknown extension.

@@ -3,6 +3,7 @@
 // headless by gnuplot (pm3d, depth-sorted triangles) so that CI draws it too.
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -17,6 +18,22 @@ struct PictureTool {
   double radius = 0.0;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
 };
+
+/// A way of looking at the organ: `right` across, `up` up, `depth` toward the viewer (right × up =
+/// depth), `focus` in the middle, everything within `half_width` of it across and up.
+struct View {
+  std::string name;
+  Eigen::Vector3d right, up, depth, focus;
+  double half_width = 0.0;
+};
+
+/// The two views of the pictures and the X3D scene: along the tool's axis (the tool's centre in the
+/// middle) and from the side (the axis up); without a tool from +z and from +x.
+std::array<View, 2> organ_views(const Eigen::MatrixX3d& deformed,
+                                const std::optional<PictureTool>& tool);
+
+/// The error colour scale (viridis) at t in [0, 1] (clamped), RGB in [0, 1].
+Eigen::Vector3d error_colour(double t);
 
 /// Writes `path` (PNG, error_picture_size): the surface at positions `deformed` (m) with each
 /// triangle coloured by the mean of its vertices' `error_mm` on one scale from 0 to `max_mm`

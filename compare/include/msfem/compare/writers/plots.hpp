@@ -21,7 +21,12 @@ bool gnuplot_available();
 struct Series {
   std::string name;
   std::vector<double> x, y;
+  std::string colour = {};  ///< "#rrggbb"; empty: gnuplot's next line colour
 };
+
+/// The colour of the i-th variant of a run in every plot of it (a variant keeps its colour however
+/// many others a plot leaves out); the FEM is black.
+std::string variant_colour(std::size_t i);
 
 /// One configuration on the accuracy-versus-speed plane.
 struct ParetoPoint {
@@ -34,11 +39,12 @@ struct ParetoPoint {
 };
 
 /// Histograms of error magnitudes (one series per variant, metres), drawn as overlaid step outlines
-/// over `bins` common bins spanning all series, counts on the y axis.
+/// over `bins` common bins spanning all series, counts on the y axis; series i in `colours[i]`
+/// where given.
 std::filesystem::path histogram(const std::filesystem::path& path, const std::string& title,
                                 const std::string& xlabel,
                                 const std::vector<std::pair<std::string, Eigen::VectorXd>>& series,
-                                int bins);
+                                int bins, const std::vector<std::string>& colours = {});
 
 /// Lines with points, one per series: the force-depth curve of the FEM and each variant, or a
 /// calibration's convergence history. A log axis refuses values that are not positive.
