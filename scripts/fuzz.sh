@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 CC=clang CXX=clang++ cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build-fuzz -j "${MSFEM_JOBS:-2}"
-for format in obj stl off ply case nifti vtu vtk xsp; do
+for format in obj stl off ply x3d case nifti vtu vtk xsp; do
   corpus=build-fuzz/corpus/$format
   mkdir -p "$corpus"
   if [ "$format" = case ]; then
@@ -25,6 +25,12 @@ for format in obj stl off ply case nifti vtu vtk xsp; do
     # A small network in each format, written by msfem's own writer (and by hand for legacy VTK).
     build-fuzz/network_seeds build-fuzz/corpus/networks >/dev/null
     cp build-fuzz/corpus/networks/*."${format/xsp/xs3}" "$corpus"/
+  elif [ "$format" = x3d ]; then
+    # A small scene in msfem's own X3D: the icosphere as write_surface writes it.
+    printf '%s\n' '<?xml version="1.0"?><X3D version="3.3"><Scene><Shape DEF="s">' \
+      '<IndexedFaceSet coordIndex="0 1 2 -1 0 2 3 -1 0 3 1 -1 1 3 2 -1">' \
+      '<Coordinate point="0 0 0, 0.01 0 0, 0 0.01 0, 0 0 0.01"/></IndexedFaceSet></Shape>' \
+      '</Scene></X3D>' >"$corpus/tetrahedron.x3d"
   else
     # Small seeds only: libFuzzer mutates them, and -max_len caps what it grows them to.
     find cases/data tests -name "*.$format" -size -200k -exec cp {} "$corpus"/ \; 2>/dev/null || true

@@ -84,8 +84,8 @@ std::vector<MassSpringParameters::Network> parse_networks(const std::string& tex
   std::vector<MassSpringParameters::Network> networks;
   for (const auto& [name, files] : parse_named_files(text, "mass spring/networks", {})) {
     if (files.size() != 1)
-      throw InputError("mass spring/networks: " + name + " names " +
-                       std::to_string(files.size()) + " files; a network is one file");
+      throw InputError("mass spring/networks: " + name + " names " + std::to_string(files.size()) +
+                       " files; a network is one file");
     networks.push_back({name, files.front()});
   }
   return networks;

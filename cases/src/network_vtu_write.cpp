@@ -6,6 +6,7 @@
 #include <cstring>
 #include <functional>
 
+#include "msfem/cases/xml_text.hpp"
 #include "network_vtu.hpp"
 #include "surface_io_detail.hpp"
 
@@ -13,28 +14,6 @@ namespace msfem::cases::detail {
 
 namespace {
 
-std::string escaped(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 void append_float(std::string& out, float value) {
   char buffer[32];
@@ -226,11 +205,11 @@ std::string ascii_element(const pugi::xml_node* original, const std::string& nam
       const std::string key = attribute.name();
       if (key == "format" || key == "offset" || key == "RangeMin" || key == "RangeMax") continue;
       named = named || key == "Name";
-      out += " " + key + "=\"" + escaped(key == "type" ? xml_type_name(type) : attribute.value()) +
+      out += " " + key + "=\"" + xml_escaped(key == "type" ? xml_type_name(type) : attribute.value()) +
              "\"";
     }
   if (!original) out += std::string(" type=\"") + xml_type_name(type) + "\"";
-  if (!named) out += " Name=\"" + escaped(name) + "\"";
+  if (!named) out += " Name=\"" + xml_escaped(name) + "\"";
   out += " format=\"ascii\">\n";
   append_values(out, values.size(), indent + "  ", [&](std::string& text, std::size_t i) {
     if (type == ValueType::float32)

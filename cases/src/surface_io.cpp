@@ -301,12 +301,13 @@ void write_surface(const fs::path& path, const Surface& surface,
       detail::write_ply(bytes, in_unit, unit_name, options.binary);
       break;
     case SurfaceFormat::x3d:
-      bytes = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<X3D profile=\"Interchange\" "
-              "version=\"3.3\">\n  <head>\n    <meta name=\"unit\" content=\"" +
-              unit_name + "\"/>\n  </head>\n  <Scene>\n" +
-              x3d_shape("surface", in_unit.vertices, in_unit.triangles, Eigen::MatrixX3d(), "",
-                        "    ") +
-              "  </Scene>\n</X3D>\n";
+      bytes =
+          "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<X3D profile=\"Interchange\" "
+          "version=\"3.3\">\n  <head>\n    <meta name=\"unit\" content=\"" +
+          unit_name + "\"/>\n  </head>\n  <Scene>\n" +
+          x3d_shape("surface", in_unit.vertices, in_unit.triangles, Eigen::MatrixX3d(), "",
+                    "    ") +
+          "  </Scene>\n</X3D>\n";
       break;
   }
   // Same folder, so the rename is atomic; the pid keeps concurrent writers apart.

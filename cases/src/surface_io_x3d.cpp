@@ -1,7 +1,7 @@
-#include <pugixml.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <pugixml.hpp>
 #include <vector>
 
 #include "msfem/cases/x3d.hpp"
@@ -77,8 +77,7 @@ Surface read_x3d_surface_bytes(const std::filesystem::path& file, const std::str
     for (int k = 0; k < 3; ++k)
       if (!detail::parse_double(xyz[p + std::size_t(k)], x[k]) || !std::isfinite(x[k]))
         detail::fail(file, "Coordinate point " + std::to_string(p / 3) + ": " +
-                               detail::quoted(xyz[p + std::size_t(k)]) +
-                               " is not a finite number");
+                               detail::quoted(xyz[p + std::size_t(k)]) + " is not a finite number");
     builder.add_vertex(x[0], x[1], x[2]);
   }
   const long long n = static_cast<long long>(builder.num_vertices());
@@ -96,8 +95,8 @@ Surface read_x3d_surface_bytes(const std::filesystem::path& file, const std::str
   for (const std::string_view token : tokens(faces.attribute("coordIndex").value())) {
     long long index = 0;
     if (!detail::parse_integer(token, index))
-      detail::fail(file, "coordIndex face " + std::to_string(face) + ": " +
-                             detail::quoted(token) + " is not an integer");
+      detail::fail(file, "coordIndex face " + std::to_string(face) + ": " + detail::quoted(token) +
+                             " is not an integer");
     if (index == -1) {
       close_face();
     } else if (index < 0 || index >= n) {
@@ -120,12 +119,23 @@ std::string xml_escaped(const std::string& text) {
   std::string out;
   for (const char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;

@@ -16,10 +16,8 @@ int main(int argc, char** argv) {
   const auto beam = msfem::testing::make_sofa_beam({});
   msfem::testing::write_sofa_beam_vtu(beam, dir / "beam.vtu");
   msfem::testing::write_sofa_beam_xsp(beam, dir / "beam.xs3");
-  msfem::testing::write_sofa_beam_case(dir / "beam.prm", "beam.vtu",
-                                       "vtu=beam.vtu; xsp=beam.xs3");
-  std::cout << "beam: " << beam.points.rows() << " nodes, " << beam.springs.size()
-            << " springs, " << beam.triangles.size() << " surface triangles in " << dir.string()
-            << "\n";
+  msfem::testing::write_sofa_beam_case(dir / "beam.prm", "beam.vtu", "vtu=beam.vtu; xsp=beam.xs3");
+  std::cout << "beam: " << beam.points.rows() << " nodes, " << beam.springs.size() << " springs, "
+            << beam.triangles.size() << " surface triangles in " << dir.string() << "\n";
   return 0;
 }

@@ -33,8 +33,7 @@ struct SofaBeam {
 
   int id(int i, int j, int k) const { return i + nx * (j + ny * k); }
   double node_mass() const {
-    return density * (nx - 1) * (ny - 1) * (nz - 1) * spacing * spacing * spacing /
-           (nx * ny * nz);
+    return density * (nx - 1) * (ny - 1) * (nz - 1) * spacing * spacing * spacing / (nx * ny * nz);
   }
   double spring_stiffness(std::size_t s) const {
     return group[s] == 0 ? stiffness : stiffness * diagonal_scale;

@@ -1,8 +1,8 @@
-// stand_in_simulator LOADDIR OUT.vtu: an outside simulator, as the tests stand one in. It reads only
-// what msfem export-load wrote (surface.vtu, loads.json), builds msfem's single-layer network on
-// that surface with the material given there, presses the first load's tool along its curve depths
-// (contact, or the prescribed patch), and writes its answer as a simulator would: the deformed
-// surface with point data `displacement` and the tool force in OUT.force.json.
+// stand_in_simulator LOADDIR OUT.vtu: an outside simulator, as the tests stand one in. It reads
+// only what msfem export-load wrote (surface.vtu, loads.json), builds msfem's single-layer network
+// on that surface with the material given there, presses the first load's tool along its curve
+// depths (contact, or the prescribed patch), and writes its answer as a simulator would: the
+// deformed surface with point data `displacement` and the tool force in OUT.force.json.
 #include <filesystem>
 #include <fstream>
 #include <iostream>

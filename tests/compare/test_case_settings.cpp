@@ -113,17 +113,16 @@ TEST(CaseSettings, TheCalibratedVariantIsABuiltInOneOrANetworkOfTheCase) {
               std::string(entry.name));
   TemporaryDirectory dir;
   std::ofstream(dir / "mine.vtu") << "";  // read when a run builds it, not with the case
-  EXPECT_EQ(with({"mass spring/networks=mine=" + (dir / "mine.vtu").string(),
-                  "calibration/variant=mine"})
-                .calibration.variant,
-            "mine");
+  EXPECT_EQ(
+      with({"mass spring/networks=mine=" + (dir / "mine.vtu").string(), "calibration/variant=mine"})
+          .calibration.variant,
+      "mine");
   try {
     with({"calibration/variant=no_such_value"});
     ADD_FAILURE() << "an unknown variant was accepted";
   } catch (const cases::InputError& e) {
     const std::string message = e.what();
-    EXPECT_NE(message.find("calibration/variant: unknown value 'no_such_value'"),
-              std::string::npos)
+    EXPECT_NE(message.find("calibration/variant: unknown value 'no_such_value'"), std::string::npos)
         << message;
   }
 }

@@ -143,8 +143,7 @@ TEST_F(ExternalResults, ASecondProgramsAnswerFromTheExportedLoadsIsMeasuredAsThe
                              " --set 'mass spring/results=sim=" +
                              answer + "' --out " + path("stand_in_run_" + name).string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const auto s =
-        nlohmann::json::parse(read_text(path("stand_in_run_" + name) / "summary.json"));
+    const auto s = nlohmann::json::parse(read_text(path("stand_in_run_" + name) / "summary.json"));
     const auto& built = variant(s, "single_layer");
     for (const char* metric :
          {"rel_l2_error", "max_error_m", "reaction_force_rel_error", "volume_change"})
@@ -214,9 +213,9 @@ TEST_F(ExternalResults, BadResultFilesAreRefusedNamingTheFileAndItem) {
     EXPECT_FALSE(std::filesystem::exists(out)) << file;
   }
   // One file per load.
-  const auto two = run_msfem("run " + sphere + " --quiet --no-timing" +
-                             results("sim=" + path("fem.vtu").string() + "," +
-                                     path("fem.vtu").string()));
+  const auto two =
+      run_msfem("run " + sphere + " --quiet --no-timing" +
+                results("sim=" + path("fem.vtu").string() + "," + path("fem.vtu").string()));
   EXPECT_EQ(two.exit_code, 2);
   EXPECT_NE(two.err.find("2 files for the case's 1 loads"), std::string::npos) << two.err;
 }

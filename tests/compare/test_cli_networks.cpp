@@ -6,8 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "cli_runner.hpp"
@@ -176,13 +176,13 @@ TEST(CliNetworks, ANetworkOfAnotherGeometryIsRefusedNamingTheVertex) {
 // and the sweep says so.
 TEST(CliNetworks, ASweepRunsANetworkAtTheCasesOwnResolutionOnlyAndSaysSo) {
   TemporaryDirectory tmp;
-  const std::string bonded = cheap("sphere_indent_bonded.prm") +
-                             " --set 'mass spring/variants=three_tier'";
+  const std::string bonded =
+      cheap("sphere_indent_bonded.prm") + " --set 'mass spring/variants=three_tier'";
   ASSERT_EQ(run_msfem("export-network " + bonded + " " + (tmp / "nets").string()).exit_code, 0);
-  const auto r = run_msfem("sweep " + bonded + " --quiet --resolutions 1,2 --integrators " +
-                           "symplectic_euler --set 'mass spring/networks=mine=" +
-                           (tmp / "nets" / "three_tier.vtu").string() + "' --out " +
-                           (tmp / "sweep").string());
+  const auto r =
+      run_msfem("sweep " + bonded + " --quiet --resolutions 1,2 --integrators " +
+                "symplectic_euler --set 'mass spring/networks=mine=" +
+                (tmp / "nets" / "three_tier.vtu").string() + "' --out " + (tmp / "sweep").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto s = nlohmann::json::parse(read_text(tmp / "sweep" / "sweep.json"));
   std::map<std::pair<std::string, int>, double> error;

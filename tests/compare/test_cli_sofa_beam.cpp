@@ -150,9 +150,8 @@ const std::string loads =
     " --train '0,0,1@0.004; 0,1,0@0.003' --test '0,0,-1@0.002; 0,-1,0@0.0025'";
 
 TEST_F(SofaBeamNetwork, TwoGroupsCalibratedAreHandedBackAndRunAgainToTheSameNumbers) {
-  const auto r = run_msfem("calibrate " + path("beam.prm").string() + tool +
-                           " --variant vtu" + loads + " --quiet --no-compare --out " +
-                           path("cal").string());
+  const auto r = run_msfem("calibrate " + path("beam.prm").string() + tool + " --variant vtu" +
+                           loads + " --quiet --no-compare --out " + path("cal").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto c = nlohmann::json::parse(read_text(path("cal") / "calibration.json"));
   EXPECT_LT(mean_test_error(c["after"]), 0.8 * mean_test_error(c["before"]));
@@ -177,9 +176,9 @@ TEST_F(SofaBeamNetwork, TwoGroupsCalibratedAreHandedBackAndRunAgainToTheSameNumb
   }
 
   // calibrated.prm runs the handed-back file: its numbers before any fit are the fit's.
-  const auto again = run_msfem("calibrate " + (path("cal") / "calibrated.prm").string() + tool +
-                               loads + " --max-evaluations 3 --quiet --no-compare --out " +
-                               path("again").string());
+  const auto again =
+      run_msfem("calibrate " + (path("cal") / "calibrated.prm").string() + tool + loads +
+                " --max-evaluations 3 --quiet --no-compare --out " + path("again").string());
   ASSERT_EQ(again.exit_code, 0) << again.err;
   const auto d = nlohmann::json::parse(read_text(path("again") / "calibration.json"));
   EXPECT_EQ(d["variant"], "vtu");

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "cli_runner.hpp"
-#include "png_reader.hpp"
 #include "msfem/cases/surface_generators.hpp"
 #include "msfem/compare/writers/error_picture.hpp"
 #include "msfem/compare/writers/plots.hpp"
+#include "png_reader.hpp"
 
 namespace msfem {
 namespace {

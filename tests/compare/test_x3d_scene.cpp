@@ -44,10 +44,10 @@ bool program_runs(const std::string& command) {
 TEST_F(X3dScene, IsX3dThatReadsBackAsTheRunsSurfaces) {
   const auto scene = run() / "scene.x3d";
   const std::string text = read_text(scene);
-  for (const char* node : {"<X3D profile=\"Interchange\" version=\"3.3\">", "<Scene>",
-                           "<Viewpoint DEF=\"view_along\"", "<Viewpoint DEF=\"view_side\"",
-                           "<IndexedFaceSet", "<Coordinate point=", "<Color color=",
-                           "<Sphere radius=\"0.005"})
+  for (const char* node :
+       {"<X3D profile=\"Interchange\" version=\"3.3\">", "<Scene>", "<Viewpoint DEF=\"view_along\"",
+        "<Viewpoint DEF=\"view_side\"", "<IndexedFaceSet",
+        "<Coordinate point=", "<Color color=", "<Sphere radius=\"0.005"})
     EXPECT_NE(text.find(node), std::string::npos) << node;
   if (program_runs("xmllint --version"))
     EXPECT_TRUE(program_runs("xmllint --noout " + scene.string()));

@@ -1,8 +1,8 @@
 // libFuzzer target for one of msfem's input readers, chosen at compile time (MSFEM_FUZZ_OBJ, _STL,
-// _OFF, _PLY, _CASE, _NIFTI). A reader may refuse an input only with cases::InputError; anything
-// else (a crash, a hang, a sanitizer report, another exception, a surface it returns with an index
-// out of range or a non-finite coordinate, an image with a non-finite voxel or a transform that is
-// not finite and invertible) is a defect the fuzzer reports.
+// _OFF, _PLY, _X3D, _CASE, _NIFTI). A reader may refuse an input only with cases::InputError;
+// anything else (a crash, a hang, a sanitizer report, another exception, a surface it returns with
+// an index out of range or a non-finite coordinate, an image with a non-finite voxel or a transform
+// that is not finite and invertible) is a defect the fuzzer reports.
 
 #include <cstddef>
 #include <cstdint>
@@ -18,6 +18,9 @@
 #endif
 #ifdef MSFEM_FUZZ_CASE
 #include "case_file_text.hpp"
+#endif
+#ifdef MSFEM_FUZZ_X3D
+#include "msfem/cases/x3d.hpp"
 #endif
 #ifdef MSFEM_FUZZ_NIFTI
 #include <unistd.h>
@@ -82,6 +85,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(msfem::cases::detail::read_off("fuzz.off", bytes));
 #elif defined(MSFEM_FUZZ_PLY)
     check(msfem::cases::detail::read_ply("fuzz.ply", bytes));
+#elif defined(MSFEM_FUZZ_X3D)
+    check(msfem::cases::read_x3d_surface_bytes("fuzz.x3d", std::string(bytes)));
 #elif defined(MSFEM_FUZZ_CASE)
     // The language's sections as the case reader passes them; includes resolve under /nonexistent
     // so the fuzzer cannot make the target read the machine's files.

@@ -87,10 +87,10 @@ std::vector<std::string> checked_fit_groups(const cases::CaseParameters& p,
       for (const auto& k : known)
         list += (list.empty() ? "" : ", ") + k;
       const std::string hint =
-          g != volume_group    ? ""
-          : variant.builtin    ? "; " + std::string(volume_hint)
-                               : "; a network's fit is handed back as new spring coefficients in "
-                                 "its file, and its volume elements keep the file's bulk_modulus";
+          g != volume_group ? ""
+          : variant.builtin ? "; " + std::string(volume_hint)
+                            : "; a network's fit is handed back as new spring coefficients in "
+                              "its file, and its volume elements keep the file's bulk_modulus";
       throw cases::InputError(p.file.string() + ": calibration: variant " + variant.name +
                               " has no group '" + g + "' to fit (its groups: " + list + hint + ")");
     }
@@ -300,8 +300,9 @@ void hand_back_network(CaseCalibration& c, const cases::CaseParameters& paramete
     h.damping = massspring::damping_for_ratio(calibrated.network(), c.damping.case_damping_ratio);
   std::string networks = "mass spring/networks=";
   for (const auto& n : parameters.mass_spring.networks)
-    networks += (&n == &parameters.mass_spring.networks.front() ? "" : "; ") + n.name + "=" +
-                (n.name == c.variant.name ? h.file_name : std::filesystem::absolute(n.file).string());
+    networks +=
+        (&n == &parameters.mass_spring.networks.front() ? "" : "; ") + n.name + "=" +
+        (n.name == c.variant.name ? h.file_name : std::filesystem::absolute(n.file).string());
   c.calibrated_overrides.push_back(networks);
   c.hand_back = std::move(h);
 }

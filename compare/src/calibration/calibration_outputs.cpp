@@ -254,8 +254,8 @@ void write_calibration_outputs(const CaseCalibration& c, const std::filesystem::
       best.x.push_back(static_cast<double>(i + 1));
       best.y.push_back(std::max(lowest, 1e-300));
     }
-    plot = xy_lines(dir / "convergence.png", "calibration of " + c.variant.name,
-                    "evaluation", "objective J", {all, best}, false, true)
+    plot = xy_lines(dir / "convergence.png", "calibration of " + c.variant.name, "evaluation",
+                    "objective J", {all, best}, false, true)
                .filename()
                .string();
   }
@@ -265,9 +265,8 @@ void write_calibration_outputs(const CaseCalibration& c, const std::filesystem::
     cases::write_network_with_coefficients(c.hand_back->original, dir / c.hand_back->file_name,
                                            c.hand_back->stiffness, c.hand_back->damping);
   std::vector<std::string> overrides = c.calibrated_overrides;
-  std::string header = "# Calibrated by msfem calibrate (variant " + c.variant.name +
-                       ", git " + git_revision() + ") from " + c.problem.parameters.file.string() +
-                       "\n";
+  std::string header = "# Calibrated by msfem calibrate (variant " + c.variant.name + ", git " +
+                       git_revision() + ") from " + c.problem.parameters.file.string() + "\n";
   write_text_atomically(dir / "calibrated.prm",
                         header + cases::case_file_text(c.problem.parameters.file, overrides));
 }

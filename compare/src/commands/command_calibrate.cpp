@@ -45,8 +45,7 @@ int calibrate_command(const Arguments& args) {
   const cases::CaseParameters parameters = cases::read_case(opt.positional()[0], overrides);
 
   CalibrationRequest request;
-  if (const auto variant = opt.value("variant"))
-    request.variant = *variant;
+  if (const auto variant = opt.value("variant")) request.variant = *variant;
   if (opt.value("fit")) request.groups = split_groups(*opt.value("fit"));
   if (opt.value("train")) request.train = cases::parse_tool_loads(*opt.value("train"), "--train");
   if (opt.value("test")) request.test = cases::parse_tool_loads(*opt.value("test"), "--test");
@@ -77,8 +76,7 @@ int calibrate_command(const Arguments& args) {
     if (opt.flag("json")) {
       printed << calibration_json(c).dump(2) << '\n';
     } else {
-      printed << "calibrate " << parameters.name << ", variant " << c.variant.name
-              << ":\n"
+      printed << "calibrate " << parameters.name << ", variant " << c.variant.name << ":\n"
               << calibration_table(c) << "results in " << final_dir.string() << "\n";
     }
   });

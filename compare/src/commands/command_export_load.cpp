@@ -20,7 +20,9 @@
 namespace msfem::compare {
 namespace {
 
-nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+nlohmann::json vector_json(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 // One tool position: where it touches, its sphere's centre at each curve depth and at full depth,
 // and for the bonded tool the displacement it prescribes at each surface vertex it holds.
@@ -78,8 +80,8 @@ nlohmann::json loads_json(const Problem& problem) {
     fixed += problem.fixed_region(problem.surface.vertices.row(v).transpose());
   nlohmann::json loads = nlohmann::json::array();
   for (std::size_t t = 0; t < problem.tools.size(); ++t)
-    loads.push_back({{"index", t},
-                     {"tool", tool_json(problem, problem.tools[t], p.loads.tool.directions[t])}});
+    loads.push_back(
+        {{"index", t}, {"tool", tool_json(problem, problem.tools[t], p.loads.tool.directions[t])}});
   if (loads.empty()) loads.push_back({{"index", 0}, {"tool", nullptr}});
   return {
       {"schema", external::loads_schema},
@@ -87,7 +89,10 @@ nlohmann::json loads_json(const Problem& problem) {
       {"case", p.name},
       {"case_file", p.file.string()},
       {"units",
-       {{"length", "m"}, {"force", "N"}, {"stress", "Pa"}, {"acceleration", "m/s^2"},
+       {{"length", "m"},
+        {"force", "N"},
+        {"stress", "Pa"},
+        {"acceleration", "m/s^2"},
         {"density", "kg/m^3"}}},
       {"surface",
        {{"file", "surface.vtu"},

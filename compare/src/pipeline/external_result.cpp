@@ -44,7 +44,8 @@ Eigen::MatrixX3d displacement_from(const Eigen::MatrixX3d& points,
       refuse(where, file,
              "point data 'displacement' has " + std::to_string(displacement->cols()) +
                  " components; a displacement has 3");
-    // The file's points are the rest positions or the deformed ones; either way in the case's order.
+    // The file's points are the rest positions or the deformed ones; either way in the case's
+    // order.
     for (Eigen::Index v = 0; v < rest.rows(); ++v) {
       const double off = std::min(u.row(v).norm(), (u.row(v) - displacement->row(v)).norm());
       if (off > 1e-6 * size)
@@ -160,8 +161,9 @@ ExternalAnswer read_external_answer(const std::filesystem::path& file, const Pro
   const std::filesystem::path json = beside(file, ".force.json");
   if (std::filesystem::exists(json)) {
     if (field_force)
-      refuse(where, file, "the force is given twice (field data tool_force and " +
-                              json.filename().string() + ")");
+      refuse(
+          where, file,
+          "the force is given twice (field data tool_force and " + json.filename().string() + ")");
     a.tool_force = force_from_json(json, where);
   } else {
     a.tool_force = field_force;

@@ -212,8 +212,8 @@ void build_network_variant(BuiltVariant& variant, const Problem& problem) {
   const Eigen::Vector3d& g = p.loads.gravity_m_per_s2;
   if (!n.gravity.isZero() && (n.gravity - g).norm() > 1e-9 * std::max(g.norm(), n.gravity.norm()))
     variant.warnings.push_back("the file's grav " + point_text(n.gravity) +
-                               " m/s^2 is not applied: the case's loads/gravity " +
-                               point_text(g) + " is, as for every variant");
+                               " m/s^2 is not applied: the case's loads/gravity " + point_text(g) +
+                               " is, as for every variant");
   if (n.viscosity && *n.viscosity != 0)
     variant.warnings.push_back("the file's visc (" + std::to_string(*n.viscosity) +
                                ") is not applied: dampers come from mass spring/damping ratio");

@@ -152,9 +152,9 @@ nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& d
     nlohmann::json metrics = nlohmann::json::object();
     for (const auto& m : regression_metrics())
       if (std::isfinite(metric_value(v.loads.front(), m)))  // an outside answer without a force
-      metrics[m] = {{"value", metric_value(v.loads.front(), m)},
-                    {"abs_tol", metric_abs_tol},
-                    {"rel_tol", metric_rel_tol}};
+        metrics[m] = {{"value", metric_value(v.loads.front(), m)},
+                      {"abs_tol", metric_abs_tol},
+                      {"rel_tol", metric_rel_tol}};
     variants[v.name] = {{"metrics", metrics},
                         {"field",
                          {{"dataset", "/variants/" + v.name + "/displacement"},

@@ -295,8 +295,9 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
     progress.stage(result.networks->note);
   }
   if (!parameters.mass_spring.results.empty())
-    progress.stage("mass spring/results are not swept: an outside answer has one resolution and "
-                   "no speed msfem can measure (msfem run compares it)");
+    progress.stage(
+        "mass spring/results are not swept: an outside answer has one resolution and "
+        "no speed msfem can measure (msfem run compares it)");
   for (std::size_t r = 0; r < sweeps.size(); ++r) {
     const bool of_networks = sweeps[r].second.mass_spring.variants.empty();
     try {
@@ -316,8 +317,8 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
     } catch (const std::exception& e) {
       if (!first_failure) first_failure = std::current_exception();
       result.failed_resolutions.emplace_back(sweeps[r].first, e.what());
-      progress.stage("sweep resolution " + std::to_string(sweeps[r].first) + " failed: " +
-                     e.what());
+      progress.stage("sweep resolution " + std::to_string(sweeps[r].first) +
+                     " failed: " + e.what());
     }
     progress.advance(
         "sweep resolution " + std::to_string(sweeps[r].first), static_cast<int>(r + 1),

@@ -82,8 +82,8 @@ std::string patches(const Eigen::MatrixX3d& x, const Eigen::MatrixX3i& triangles
 }
 
 std::string panel_commands(const Panel& panel, const std::string& title, const View& camera,
-                           const std::optional<PictureTool>& tool,
-                           const char* data, bool colour_bar) {
+                           const std::optional<PictureTool>& tool, const char* data,
+                           bool colour_bar) {
   std::ostringstream c;
   c << "set lmargin at screen " << panel.left << "\nset rmargin at screen " << panel.right
     << "\nset tmargin at screen " << panel_top << "\nset bmargin at screen " << panel_bottom
@@ -92,9 +92,8 @@ std::string panel_commands(const Panel& panel, const std::string& title, const V
     << "]\nunset object\n";
   if (tool) {
     const Eigen::Vector3d d = tool->center - camera.focus;
-    c << "set object 1 circle at " << number(d.dot(camera.right)) << ","
-      << number(d.dot(camera.up)) << " size " << number(tool->radius)
-      << " front fillstyle empty border lc rgb 'black' lw 2\n";
+    c << "set object 1 circle at " << number(d.dot(camera.right)) << "," << number(d.dot(camera.up))
+      << " size " << number(tool->radius) << " front fillstyle empty border lc rgb 'black' lw 2\n";
   }
   c << (colour_bar ? "set colorbox user origin screen 0.91,0.08 size screen 0.02,0.8\n"
                    : "unset colorbox\n")
@@ -133,16 +132,24 @@ std::array<View, 2> organ_views(const Eigen::MatrixX3d& deformed,
     side.focus += 0.5 * (low + high) * n;
   } else {
     const Eigen::Vector3d centre = deformed.colwise().mean().transpose();
-    along = {"from +z", Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
-             Eigen::Vector3d::UnitZ(), centre, 0.0};
-    side = {"from +x", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
-            Eigen::Vector3d::UnitX(), centre, 0.0};
+    along = {"from +z",
+             Eigen::Vector3d::UnitX(),
+             Eigen::Vector3d::UnitY(),
+             Eigen::Vector3d::UnitZ(),
+             centre,
+             0.0};
+    side = {"from +x",
+            Eigen::Vector3d::UnitY(),
+            Eigen::Vector3d::UnitZ(),
+            Eigen::Vector3d::UnitX(),
+            centre,
+            0.0};
   }
   for (View* view : {&along, &side}) {
     for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
       const Eigen::Vector3d d = deformed.row(v).transpose() - view->focus;
-      view->half_width = std::max(
-          {view->half_width, std::abs(d.dot(view->right)), std::abs(d.dot(view->up))});
+      view->half_width =
+          std::max({view->half_width, std::abs(d.dot(view->right)), std::abs(d.dot(view->up))});
     }
     view->half_width *= 1.05;
   }
@@ -161,8 +168,8 @@ std::filesystem::path error_picture(const std::filesystem::path& path, const std
                                     const Eigen::VectorXd& error_mm, double max_mm,
                                     const std::optional<PictureTool>& tool) {
   if (error_mm.size() != deformed.rows())
-    throw std::invalid_argument("error picture '" + path.string() + "': " +
-                                std::to_string(error_mm.size()) + " errors for " +
+    throw std::invalid_argument("error picture '" + path.string() +
+                                "': " + std::to_string(error_mm.size()) + " errors for " +
                                 std::to_string(deformed.rows()) + " vertices");
   if (!deformed.allFinite() || !error_mm.allFinite() || !std::isfinite(max_mm))
     throw std::invalid_argument("error picture '" + path.string() + "': a value is not finite");
@@ -175,8 +182,8 @@ std::filesystem::path error_picture(const std::filesystem::path& path, const std
   std::ostringstream c;
   c << "unset grid\nunset key\nset view map\nset pm3d depthorder\nset pm3d corners2color c1\n"
     << "unset xtics\nunset ytics\nunset ztics\nunset border\n"
-    << gnuplot_palette()
-    << "set cbrange [0:" << number(top) << "]\nset cblabel 'error |u - u_FEM| (mm)'\n"
+    << gnuplot_palette() << "set cbrange [0:" << number(top)
+    << "]\nset cblabel 'error |u - u_FEM| (mm)'\n"
     << "set multiplot title " << quoted(title) << "\n"
     << panel_commands(along_panel, views[0].name, views[0], tool, "data", false)
     << panel_commands(side_panel, views[1].name, views[1], tool, "data2", true)

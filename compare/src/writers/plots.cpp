@@ -186,8 +186,7 @@ fs::path render(const fs::path& requested, const std::string& data, const std::s
     script << format.terminal << "\n"
            << "set output " << quoted(temporary.string()) << "\n"
            << "data = " << quoted(data_file.string()) << "\n"
-           << more_names
-           << "set grid\nset key below\n"
+           << more_names << "set grid\nset key below\n"
            << commands << "unset output\n";
     write_text_atomically(script_file, script.str());
     const GnuplotRun run = run_gnuplot({script_file.string()});
@@ -272,8 +271,7 @@ fs::path histogram(const fs::path& path, const std::string& title, const std::st
   std::ostringstream commands;
   commands << labels(title, xlabel, "count") << "set yrange [0:*]\nplot ";
   for (std::size_t i = 0; i < series.size(); ++i)
-    commands << (i ? ", \\\n     " : "") << "data index " << i
-             << " using 1:2 with steps lw 2"
+    commands << (i ? ", \\\n     " : "") << "data index " << i << " using 1:2 with steps lw 2"
              << (i < colours.size() ? " lc rgb " + quoted(colours[i]) : "") << " title "
              << quoted(series[i].first);
   commands << "\n";
@@ -302,8 +300,8 @@ fs::path xy_lines(const fs::path& path, const std::string& title, const std::str
   for (std::size_t i = 0; i < series.size(); ++i)
     commands << (i ? ", \\\n     " : "") << "data index " << i
              << " using 1:2 with linespoints lw 2 pt 7 ps 0.7"
-             << (series[i].colour.empty() ? "" : " lc rgb " + quoted(series[i].colour))
-             << " title " << quoted(series[i].name);
+             << (series[i].colour.empty() ? "" : " lc rgb " + quoted(series[i].colour)) << " title "
+             << quoted(series[i].name);
   commands << "\n";
   return render(path, data.str(), commands.str());
 }

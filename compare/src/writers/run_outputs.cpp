@@ -94,11 +94,10 @@ std::vector<std::string> error_pictures(const CaseRun& run, const std::filesyste
   const std::optional<PictureTool> tool = picture_tool(run);
   for (const auto& v : run.variants) {
     const ToolLoadVariant& first = v.loads.front();
-    const auto file =
-        error_picture(dir / ("error_" + v.name + ".png"), v.name + ": error on the organ",
-                      run.problem.surface.vertices + first.surface_displacement,
-                      run.problem.surface.triangles, 1e3 * first.error.rowwise().norm(), max_mm,
-                      tool);
+    const auto file = error_picture(
+        dir / ("error_" + v.name + ".png"), v.name + ": error on the organ",
+        run.problem.surface.vertices + first.surface_displacement, run.problem.surface.triangles,
+        1e3 * first.error.rowwise().norm(), max_mm, tool);
     lines.push_back("![" + v.name + ": error on the organ](" + file.filename().string() + ")");
   }
   return lines;

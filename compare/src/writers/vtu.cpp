@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "msfem/cases/xml_text.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/vtu.hpp"
 
@@ -22,31 +23,6 @@ namespace {
 constexpr int kVtkTriangle = 5;
 constexpr int kVtkTetra = 10;
 
-std::string escape_xml(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 std::string full_precision(double value) {
   char buffer[32];
@@ -105,8 +81,8 @@ std::string active_attributes(const std::vector<PointField>& point_data) {
     if (field.values.cols() == 3 && vectors.empty()) vectors = field.name;
   }
   std::string attributes;
-  if (!scalars.empty()) attributes += " Scalars=\"" + escape_xml(scalars) + "\"";
-  if (!vectors.empty()) attributes += " Vectors=\"" + escape_xml(vectors) + "\"";
+  if (!scalars.empty()) attributes += " Scalars=\"" + cases::xml_escaped(scalars) + "\"";
+  if (!vectors.empty()) attributes += " Vectors=\"" + cases::xml_escaped(vectors) + "\"";
   return attributes;
 }
 
@@ -120,7 +96,7 @@ std::string unstructured_grid_xml(const Eigen::MatrixX3d& points, const Eigen::M
       << "\">\n";
   out << "      <PointData" << active_attributes(point_data) << ">\n";
   for (const PointField& field : point_data)
-    write_data_array(out, "Name=\"" + escape_xml(field.name) + "\"", field.values);
+    write_data_array(out, "Name=\"" + cases::xml_escaped(field.name) + "\"", field.values);
   out << "      </PointData>\n";
   out << "      <Points>\n";
   write_data_array(out, "Name=\"Points\"", points);
@@ -184,8 +160,8 @@ void write_pvd(const fs::path& path,
     if (fs::path(file).is_absolute())
       throw std::invalid_argument("dataset file '" + file +
                                   "' is absolute; give it relative to the .pvd");
-    out << "    <DataSet timestep=\"0\" part=\"" << i << "\" file=\"" << escape_xml(file)
-        << "\" name=\"" << escape_xml(name) << "\"/>\n";
+    out << "    <DataSet timestep=\"0\" part=\"" << i << "\" file=\"" << cases::xml_escaped(file)
+        << "\" name=\"" << cases::xml_escaped(name) << "\"/>\n";
   }
   out << "  </Collection>\n"
       << "</VTKFile>\n";

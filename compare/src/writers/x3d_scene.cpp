@@ -104,7 +104,8 @@ std::string html_page(const std::string& title, const std::vector<SceneSurface>&
          cases::xml_escaped(title) +
          "</h1>\n<p>Each variant's deformed surface coloured by its error against the FEM "
          "(viridis, 0 to the largest error of the run); the undeformed surface grey; the tool "
-         "red. Drag to turn, wheel to zoom; switch surfaces on and off:</p>\n<div id=\"switches\">\n" +
+         "red. Drag to turn, wheel to zoom; switch surfaces on and off:</p>\n<div "
+         "id=\"switches\">\n" +
          switches +
          "</div>\n<x3d id=\"scene\" width=\"1000px\" height=\"650px\">\n  <Scene>\n"
          // X3DOM's own node: colours as given, not gamma-corrected, so the page shows the scale.

@@ -8,13 +8,15 @@
 #include <string>
 
 #include "msfem/cases/surface.hpp"
+#include "msfem/cases/xml_text.hpp"
 
 namespace msfem::cases {
 
 /// The IndexedFaceSet of the Shape whose DEF is `def` (empty: the file's first IndexedFaceSet):
-/// its Coordinate points (in the file's units) and its faces, polygons fan-triangulated. Every fault
-/// is an InputError naming the file and the node or index: not XML, no such Shape, no Coordinate, a
-/// point that is not three finite numbers, an index out of range, a face of fewer than three.
+/// its Coordinate points (in the file's units) and its faces, polygons fan-triangulated. Every
+/// fault is an InputError naming the file and the node or index: not XML, no such Shape, no
+/// Coordinate, a point that is not three finite numbers, an index out of range, a face of fewer
+/// than three.
 Surface read_x3d_surface(const std::filesystem::path& file, const std::string& def = "");
 
 /// The same from bytes (what read_surface and the fuzz target call).
@@ -27,8 +29,5 @@ Surface read_x3d_surface_bytes(const std::filesystem::path& file, const std::str
 std::string x3d_shape(const std::string& def, const Eigen::MatrixX3d& points,
                       const Eigen::MatrixX3i& triangles, const Eigen::MatrixX3d& colours,
                       const std::string& appearance, const std::string& indent);
-
-/// Text with &, <, >, " and ' escaped for an XML attribute.
-std::string xml_escaped(const std::string& text);
 
 }  // namespace msfem::cases

@@ -23,7 +23,7 @@ inline constexpr int force_version = 1;
 
 /// One result file read against the case's surface.
 struct ExternalAnswer {
-  Eigen::MatrixX3d surface_displacement;     ///< rows in the case's surface vertex order, m
+  Eigen::MatrixX3d surface_displacement;      ///< rows in the case's surface vertex order, m
   std::optional<Eigen::Vector3d> tool_force;  ///< N, the force the tissue exerts on the tool
   std::vector<ForceDepthPoint> curve;         ///< FILE's curve.csv beside it, when there is one
 };
@@ -31,9 +31,9 @@ struct ExternalAnswer {
 /// Reads `file`: a .vtu of the deformed surface (point data `displacement`, or its deformed
 /// points), or an .obj of deformed positions, in surface.vtu's vertex order; the force as field
 /// data `tool_force` or in STEM.force.json beside it, the curve in STEM.curve.csv. Throws
-/// cases::InputError naming `where`, the file and the vertex or item at fault: a vertex count, order
-/// or unit that is not the case's, a value that is not finite, a force without 3 components, a
-/// JSON of another schema or version.
+/// cases::InputError naming `where`, the file and the vertex or item at fault: a vertex count,
+/// order or unit that is not the case's, a value that is not finite, a force without 3 components,
+/// a JSON of another schema or version.
 ExternalAnswer read_external_answer(const std::filesystem::path& file, const Problem& problem,
                                     const std::string& where);
 
