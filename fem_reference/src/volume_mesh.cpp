@@ -91,25 +91,25 @@ VolumeMesh refine_uniformly(const VolumeMesh& mesh) {
     const auto t = mesh.tetrahedra.row(e);
     const int m01 = midpoint(t(0), t(1)), m02 = midpoint(t(0), t(2)), m03 = midpoint(t(0), t(3)),
               m12 = midpoint(t(1), t(2)), m13 = midpoint(t(1), t(3)), m23 = midpoint(t(2), t(3));
-    children.push_back({t(0), m01, m02, m03});
-    children.push_back({m01, t(1), m12, m13});
-    children.push_back({m02, m12, t(2), m23});
-    children.push_back({m03, m13, m23, t(3)});
+    children.push_back({{t(0), m01, m02, m03}});
+    children.push_back({{m01, t(1), m12, m13}});
+    children.push_back({{m02, m12, t(2), m23}});
+    children.push_back({{m03, m13, m23, t(3)}});
     // The octahedron's three diagonals, each with the cycle of the four other midpoints around it.
-    const std::array<std::array<int, 6>, 3> cuts = {{{m01, m23, m02, m03, m13, m12},
-                                                     {m02, m13, m01, m03, m23, m12},
-                                                     {m03, m12, m01, m02, m23, m13}}};
+    const std::array<std::array<int, 6>, 3> cuts = {{{{m01, m23, m02, m03, m13, m12}},
+                                                     {{m02, m13, m01, m03, m23, m12}},
+                                                     {{m03, m12, m01, m02, m23, m13}}}};
     auto at = [&](int a, int b) -> Eigen::Vector3d {
       return 0.5 * (mesh.vertices.row(t(a)) + mesh.vertices.row(t(b))).transpose();
     };
-    const std::array<double, 3> diagonal = {(at(0, 1) - at(2, 3)).squaredNorm(),
-                                            (at(0, 2) - at(1, 3)).squaredNorm(),
-                                            (at(0, 3) - at(1, 2)).squaredNorm()};
+    const std::array<double, 3> diagonal = {{(at(0, 1) - at(2, 3)).squaredNorm(),
+                                             (at(0, 2) - at(1, 3)).squaredNorm(),
+                                             (at(0, 3) - at(1, 2)).squaredNorm()}};
     const auto& cut =
         cuts[std::size_t(std::min_element(diagonal.begin(), diagonal.end()) - diagonal.begin())];
     for (int k = 0; k < 4; ++k)
       children.push_back(
-          {cut[0], cut[1], cut[std::size_t(2 + k)], cut[std::size_t(2 + (k + 1) % 4)]});
+          {{cut[0], cut[1], cut[std::size_t(2 + k)], cut[std::size_t(2 + (k + 1) % 4)]}});
   }
   fine.vertices.resize(n + Eigen::Index(midpoints.size()), 3);
   fine.vertices.topRows(n) = mesh.vertices;

@@ -20,9 +20,9 @@ struct NiftiImage {
   std::vector<std::int16_t> values;  ///< stored (before slope and intercept)
   Eigen::Matrix<double, 3, 4> sform = Eigen::Matrix<double, 3, 4>::Identity();  ///< in mm
   float slope = 0.0f, intercept = 0.0f;
-  std::vector<float> reals;               ///< when not empty, stored as FLOAT32 instead of values
-  std::optional<Eigen::Vector3f> pixdim;  ///< default: the sform's column lengths
-  std::optional<double> vox_offset;       ///< default: right after the header
+  std::vector<float> reals = {};  ///< when not empty, stored as FLOAT32 instead of values
+  std::optional<Eigen::Vector3f> pixdim = {};  ///< default: the sform's column lengths
+  std::optional<double> vox_offset = {};       ///< default: right after the header
   int sform_code = 1;
   int version = 1;  ///< NIfTI-1 (348-byte header) or NIfTI-2 (540 bytes)
   bool big_endian = false;

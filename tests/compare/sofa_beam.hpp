@@ -53,14 +53,14 @@ inline SofaBeam make_sofa_beam(SofaBeam b) {
   // Six tetrahedra per cube, each a path 000 -> +e_a -> +e_b -> +e_c = 111 (Kuhn's split: the
   // same in every cube, so neighbouring cubes share their faces' diagonals).
   const std::array<std::array<int, 3>, 6> orders = {
-      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+      {{{0, 1, 2}}, {{0, 2, 1}}, {{1, 0, 2}}, {{1, 2, 0}}, {{2, 0, 1}}, {{2, 1, 0}}}};
   std::set<std::array<int, 2>> edges;
   std::map<std::array<int, 3>, std::array<int, 4>> faces;  // sorted face -> face + opposite
   for (int k = 0; k + 1 < b.nz; ++k)
     for (int j = 0; j + 1 < b.ny; ++j)
       for (int i = 0; i + 1 < b.nx; ++i)
         for (const auto& order : orders) {
-          std::array<int, 3> c = {i, j, k};
+          std::array<int, 3> c = {{i, j, k}};
           std::array<int, 4> tet;
           tet[0] = b.id(c[0], c[1], c[2]);
           for (int s = 0; s < 3; ++s) {
@@ -69,7 +69,8 @@ inline SofaBeam make_sofa_beam(SofaBeam b) {
           }
           for (int p = 0; p < 4; ++p)
             for (int q = p + 1; q < 4; ++q)
-              edges.insert({std::min(tet[p], tet[q]), std::max(tet[p], tet[q])});
+              edges.insert(
+                  std::array<int, 2>{{std::min(tet[p], tet[q]), std::max(tet[p], tet[q])}});
           for (int opposite = 0; opposite < 4; ++opposite) {
             std::array<int, 3> face;
             for (int v = 0, f = 0; v < 4; ++v)
@@ -77,7 +78,7 @@ inline SofaBeam make_sofa_beam(SofaBeam b) {
             std::array<int, 3> key = face;
             std::sort(key.begin(), key.end());
             if (faces.erase(key) == 0)
-              faces[key] = {face[0], face[1], face[2], tet[std::size_t(opposite)]};
+              faces[key] = {{face[0], face[1], face[2], tet[std::size_t(opposite)]}};
           }
         }
   for (const auto& e : edges) {
@@ -91,9 +92,9 @@ inline SofaBeam make_sofa_beam(SofaBeam b) {
     const Eigen::Vector3d a = b.points.row(f[0]).transpose(), p = b.points.row(f[1]).transpose(),
                           q = b.points.row(f[2]).transpose(), o = b.points.row(f[3]).transpose();
     if ((p - a).cross(q - a).dot(o - a) > 0)
-      b.triangles.push_back({f[0], f[2], f[1]});
+      b.triangles.push_back({{f[0], f[2], f[1]}});
     else
-      b.triangles.push_back({f[0], f[1], f[2]});
+      b.triangles.push_back({{f[0], f[1], f[2]}});
   }
   return b;
 }

@@ -60,8 +60,9 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
   for (const auto& p : j["points"]) {
     EXPECT_EQ(p["stepper"], "fast_explicit");
     errors[p["variant"].get<std::string>()].push_back(p["rel_l2_error"].get<double>());
-    if (p["volume_preservation"].get<bool>())
+    if (p["volume_preservation"].get<bool>()) {
       EXPECT_TRUE(p["variant"] == "three_tier" || p["variant"] == "tet_edges") << p.dump();
+    }
   }
   ASSERT_EQ(errors.size(), 4u);
   for (const char* volumetric : {"three_tier", "tet_edges"}) {

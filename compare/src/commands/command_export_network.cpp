@@ -31,12 +31,12 @@ void add_volume_elements(const ms::VolumeForceField& volume, cases::NetworkFile&
   for (int k = 0; k < e.num_elements(); ++k) {
     const int first = e.tet_start[std::size_t(k)], count = e.tet_start[std::size_t(k) + 1] - first;
     if (count == 1) {
-      tets.push_back({e.tets(first, 0), e.tets(first, 1), e.tets(first, 2), e.tets(first, 3)});
+      tets.push_back({{e.tets(first, 0), e.tets(first, 1), e.tets(first, 2), e.tets(first, 3)}});
       tet_modulus.push_back(e.modulus[k]);
     } else if (count == 9) {
       // (a b c a'), (b c a' b'), (c a' b' c'): the first decomposition names all six corners.
-      wedges.push_back({e.tets(first, 0), e.tets(first, 1), e.tets(first, 2), e.tets(first, 3),
-                        e.tets(first + 2, 2), e.tets(first + 2, 3)});
+      wedges.push_back({{e.tets(first, 0), e.tets(first, 1), e.tets(first, 2), e.tets(first, 3),
+                         e.tets(first + 2, 2), e.tets(first + 2, 3)}});
       wedge_modulus.push_back(e.modulus[k]);
     } else {
       throw std::runtime_error("a volume element of " + std::to_string(count) +

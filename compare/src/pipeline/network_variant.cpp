@@ -156,8 +156,8 @@ ms::VolumeElements volume_elements(const cases::NetworkFile& n, double factor) {
       const int a = n.wedges(w, r), b = n.wedges(w, (r + 1) % 3), c = n.wedges(w, (r + 2) % 3);
       const int a2 = n.wedges(w, 3 + r), b2 = n.wedges(w, 3 + (r + 1) % 3),
                 c2 = n.wedges(w, 3 + (r + 2) % 3);
-      for (const auto& tet : {std::array<int, 4>{a, b, c, a2}, std::array<int, 4>{b, c, a2, b2},
-                              std::array<int, 4>{c, a2, b2, c2}}) {
+      for (const auto& tet : {std::array<int, 4>{{a, b, c, a2}}, std::array<int, 4>{{b, c, a2, b2}},
+                              std::array<int, 4>{{c, a2, b2, c2}}}) {
         e.tets.row(t) << tet[0], tet[1], tet[2], tet[3];
         e.tet_weight[t++] = 1.0 / 3.0;
         const Eigen::Vector3d p0 = n.points.row(tet[0]).transpose();

@@ -153,7 +153,7 @@ std::array<View, 2> organ_views(const Eigen::MatrixX3d& deformed,
     }
     view->half_width *= 1.05;
   }
-  return {along, side};
+  return {{along, side}};
 }
 
 std::pair<int, int> error_picture_tool_pixel() {

@@ -33,9 +33,9 @@ struct ParetoPoint {
   std::string label;
   double realtime_factor = 0.0;  ///< simulated seconds per wall second
   double rel_error = 0.0;
-  std::string colour_group;  ///< one colour per group (the variant); empty: one group
-  std::string marker_group;  ///< one marker per group (the integrator); empty: one marker
-  bool ringed = false;       ///< marked with a ring (e.g. can run a 1 kHz loop in real time)
+  std::string colour_group = {};  ///< one colour per group (the variant); empty: one group
+  std::string marker_group = {};  ///< one marker per group (the integrator); empty: one marker
+  bool ringed = false;            ///< marked with a ring (e.g. can run a 1 kHz loop in real time)
 };
 
 /// Histograms of error magnitudes (one series per variant, metres), drawn as overlaid step outlines
