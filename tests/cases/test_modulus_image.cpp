@@ -103,7 +103,7 @@ TEST_F(ModulusImage, InterpolatesEBetweenVoxelCentresInWorldCoordinates) {
   auto world_m = [&](const Eigen::Vector3d& ijk) {
     return Eigen::Vector3d(1e-3 * (image.sform.leftCols<3>() * ijk + image.sform.col(3)));
   };
-  for (const Eigen::Vector3d ijk :
+  for (const Eigen::Vector3d& ijk :
        {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 3, 2), Eigen::Vector3d(1.25, 2.5, 0.75),
         Eigen::Vector3d(3.9, 0.1, 1)}) {
     const double hu = 10 * ijk.x() + 20 * ijk.y() + 40 * ijk.z();
@@ -216,8 +216,9 @@ TEST_F(ModulusImage, HeaderFieldsAtFaultAreNamed) {
     EXPECT_EQ(refusal(path), path.string() + ": " + expected);
     // niftilib would take a bad voxel size as 1 mm where no sform overrides it: refused alike.
     image.sform_code = 0;
-    if (expected.find("pixdim") != std::string::npos)
+    if (expected.find("pixdim") != std::string::npos) {
       EXPECT_EQ(refusal(write(image)), path.string() + ": " + expected);
+    }
   }
 }
 

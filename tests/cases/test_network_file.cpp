@@ -29,7 +29,7 @@ struct Array {
   std::string name, type;
   int components = 1;
   std::vector<double> values;
-  std::vector<std::string> strings;
+  std::vector<std::string> strings = {};
 };
 
 struct Grid {
@@ -396,7 +396,9 @@ TEST_F(NetworkFileTest, VtuRoundTripIsExact) {
   write_network(dir_ / "out.vtu", net);
   expect_same(read_network(dir_ / "out.vtu"), net);
   NetworkFile bare = net;
-  bare.damping = bare.rest_length = bare.mass = std::nullopt;
+  bare.damping.reset();
+  bare.rest_length.reset();
+  bare.mass.reset();
   bare.fixed.reset();
   write_network(dir_ / "bare.vtu", bare);
   expect_same(read_network(dir_ / "bare.vtu"), bare);

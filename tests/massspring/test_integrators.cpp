@@ -25,7 +25,7 @@ MassSpringModel single_oscillator(double k, double m, double spring_damping, dou
   net.rest_positions << 0, 0, 0, 0.1, 0, 0;
   net.masses = Eigen::Vector2d(1.0, m);
   net.node_damping = Eigen::Vector2d(0.0, node_damping);
-  net.node_group = Eigen::Vector2i(0, 0);
+  net.node_group = Eigen::VectorXi::Zero(2);
   net.node_group_names = {"all"};
   add_springs(net, {{0, 1}}, "spring");
   net.stiffness.setConstant(k);

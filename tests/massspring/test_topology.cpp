@@ -294,15 +294,17 @@ TEST(TetEdges, KuhnCubeCountsMassesAndStiffness) {
   EXPECT_NEAR(enclosed_volume(cube, network.surface_triangles), 1.0, 1e-12);
   // The main diagonal 0-7 belongs to all six tetrahedra.
   for (int s = 0; s < network.num_springs(); ++s)
-    if (network.springs(s, 0) == 0 && network.springs(s, 1) == 7)
+    if (network.springs(s, 0) == 0 && network.springs(s, 1) == 7) {
       EXPECT_NEAR(network.stiffness[s], 6.0 * lloyd_tet_edge_stiffness(5000.0, std::sqrt(3.0)),
                   1e-9);
+    }
 
   options.stiffness_rule = TetStiffnessRule::van_gelder;
   const SpringNetwork gelder = build_tet_edges(cube, tets, options);
   for (int s = 0; s < gelder.num_springs(); ++s)
-    if (gelder.springs(s, 0) == 0 && gelder.springs(s, 1) == 7)
+    if (gelder.springs(s, 0) == 0 && gelder.springs(s, 1) == 7) {
       EXPECT_NEAR(gelder.stiffness[s], 5000.0 * 1.0 / 3.0, 1e-9);  // E · (6 × 1/6) / 3
+    }
 }
 
 TEST(GeodesicSphere, CountsAndTheSeedSphere) {
@@ -315,7 +317,9 @@ TEST(GeodesicSphere, CountsAndTheSeedSphere) {
     EXPECT_EQ(static_cast<int>(unique_edges(f).size()), 30 * m * m);
     const double sphere = 4.0 / 3.0 * 3.14159265358979 * 0.05 * 0.05 * 0.05;
     EXPECT_LT(enclosed_volume(v, f), sphere);
-    if (m == 30) EXPECT_NEAR(enclosed_volume(v, f) / sphere, 1.0, 0.01);
+    if (m == 30) {
+      EXPECT_NEAR(enclosed_volume(v, f) / sphere, 1.0, 0.01);
+    }
     EXPECT_GT(enclosed_volume(v, f), 0.0);
   }
   Eigen::MatrixX3d v;
