@@ -143,8 +143,9 @@ std::string xml_escaped(const std::string& text) {
 
 std::string x3d_shape(const std::string& def, const Eigen::MatrixX3d& points,
                       const Eigen::MatrixX3i& triangles, const Eigen::MatrixX3d& colours,
-                      const std::string& appearance, const std::string& indent) {
-  std::string out = indent + "<Shape DEF=\"" + xml_escaped(def) + "\">\n";
+                      const std::string& appearance, const std::string& indent,
+                      const std::string& attributes) {
+  std::string out = indent + "<Shape DEF=\"" + xml_escaped(def) + "\"" + attributes + ">\n";
   if (!appearance.empty()) out += indent + "  " + appearance + "\n";
   out += indent + "  <IndexedFaceSet solid=\"false\" colorPerVertex=\"true\" coordIndex=\"";
   for (Eigen::Index t = 0; t < triangles.rows(); ++t) {
@@ -160,7 +161,7 @@ std::string x3d_shape(const std::string& def, const Eigen::MatrixX3d& points,
       detail::append_number(out, points(p, k));
       if (p + 1 < points.rows() || k < 2) out += ' ';
     }
-  out += "\"/>\n";
+  out += "\"></Coordinate>\n";
   if (colours.rows() > 0) {
     out += indent + "    <Color color=\"";
     char text[64];
@@ -170,7 +171,7 @@ std::string x3d_shape(const std::string& def, const Eigen::MatrixX3d& points,
       out += text;
       if (p + 1 < colours.rows()) out += ", ";
     }
-    out += "\"/>\n";
+    out += "\"></Color>\n";
   }
   out += indent + "  </IndexedFaceSet>\n" + indent + "</Shape>\n";
   return out;

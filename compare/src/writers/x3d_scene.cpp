@@ -30,71 +30,54 @@ std::string viewpoint(const View& view, const std::string& def) {
   std::snprintf(angle, sizeof angle, "%.9g", turn.angle());
   return "<Viewpoint DEF=\"" + def + "\" description=\"" + cases::xml_escaped(view.name) +
          "\" position=\"" + triple(position) + "\" orientation=\"" + triple(turn.axis()) + " " +
-         angle + "\" centerOfRotation=\"" + triple(view.focus) + "\"/>";
+         angle + "\" centerOfRotation=\"" + triple(view.focus) + "\"></Viewpoint>";
 }
 
-// Every node of the scene (between <Scene> and </Scene>), shared by scene.x3d and scene.html.
+// Every node of the scene (between <Scene> and </Scene>), each with its end tag so that scene.x3d
+// and scene.html hold the same text; on the page each Shape also has an id (its DEF) and X3DOM's
+// `render`, the first variant shown and the rest a click away (overlapping surfaces would hide
+// each other).
 std::string scene_nodes(const Eigen::MatrixX3i& triangles,
                         const std::vector<SceneSurface>& surfaces, double max_mm,
-                        const std::optional<PictureTool>& tool) {
+                        const std::optional<PictureTool>& tool, bool page) {
   const std::array<View, 2> views = organ_views(surfaces.front().points, tool);
   std::string out = "    " + viewpoint(views[0], "view_along") + "\n    " +
                     viewpoint(views[1], "view_side") + "\n";
-  out += "    <Background skyColor=\"1 1 1\"/>\n";
-  for (const SceneSurface& s : surfaces) {
+  out += "    <Background skyColor=\"1 1 1\"></Background>\n";
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    const SceneSurface& s = surfaces[i];
     Eigen::MatrixX3d colours;
     std::string appearance =
-        "<Appearance><Material diffuseColor=\"0.75 0.75 0.75\" transparency=\"0.6\"/></Appearance>";
+        "<Appearance><Material diffuseColor=\"0.75 0.75 0.75\" transparency=\"0.6\">"
+        "</Material></Appearance>";
     if (s.error_mm) {
       colours.resize(s.points.rows(), 3);
       for (Eigen::Index v = 0; v < s.points.rows(); ++v)
         colours.row(v) = error_colour(max_mm > 0 ? (*s.error_mm)[v] / max_mm : 0.0).transpose();
       appearance = "";  // no Material: unlit, each vertex exactly its colour on the scale
     }
-    out += cases::x3d_shape(s.name, s.points, triangles, colours, appearance, "    ");
+    const std::string shown = i == 1 || surfaces.size() == 1 ? "true" : "false";
+    out += cases::x3d_shape(
+        s.name, s.points, triangles, colours, appearance, "    ",
+        page ? " id=\"" + cases::xml_escaped(s.name) + "\" render=\"" + shown + "\"" : "");
   }
   if (tool)
     out += "    <Transform DEF=\"tool\" translation=\"" + triple(tool->center) +
            "\">\n      <Shape>\n        <Appearance><Material diffuseColor=\"0.8 0.2 0.2\" "
-           "transparency=\"0.3\"/></Appearance>\n        <Sphere radius=\"" +
-           std::to_string(tool->radius) + "\"/>\n      </Shape>\n    </Transform>\n";
+           "transparency=\"0.3\"></Material></Appearance>\n        <Sphere radius=\"" +
+           std::to_string(tool->radius) + "\"></Sphere>\n      </Shape>\n    </Transform>\n";
   return out;
-}
-
-// HTML has no self-closing elements but its void ones: <Coordinate .../> would stay open and
-// swallow what follows, so every <Name .../> becomes <Name ...></Name>.
-std::string with_closing_tags(const std::string& xml) {
-  std::string out;
-  std::size_t at = 0;
-  while (true) {
-    const std::size_t close = xml.find("/>", at);
-    if (close == std::string::npos) break;
-    const std::size_t open = xml.rfind('<', close);
-    const std::size_t name_end = xml.find_first_of(" \n/>", open + 1);
-    out += xml.substr(at, close - at) + "></" + xml.substr(open + 1, name_end - open - 1) + ">";
-    at = close + 2;
-  }
-  return out + xml.substr(at);
 }
 
 std::string html_page(const std::string& title, const std::vector<SceneSurface>& surfaces,
                       const std::string& nodes) {
-  // The first variant shown, the rest (and the undeformed surface) a click away: overlapping
-  // surfaces would hide each other.
   std::string switches;
   for (std::size_t i = 0; i < surfaces.size(); ++i)
     switches += "  <label><input type=\"checkbox\"" + std::string(i == 1 ? " checked" : "") +
                 " onchange=\"show('" + surfaces[i].name + "', this.checked)\"> " +
                 cases::xml_escaped(surfaces[i].name) + "</label>\n";
-  // X3DOM takes the X3D nodes in the page itself (no request for scene.x3d, which a browser
-  // refuses for a page opened from disk); a Shape's DEF is its id, `render` shows or hides it.
-  std::string page_nodes = with_closing_tags(nodes);
-  for (std::size_t i = 0; i < surfaces.size(); ++i) {
-    const std::string def = "<Shape DEF=\"" + cases::xml_escaped(surfaces[i].name) + "\"";
-    page_nodes.replace(page_nodes.find(def), def.size(),
-                       def + " id=\"" + cases::xml_escaped(surfaces[i].name) + "\" render=\"" +
-                           (i == 1 || surfaces.size() == 1 ? "true" : "false") + "\"");
-  }
+  // X3DOM takes the X3D nodes in the page itself: no request for scene.x3d, which a browser
+  // refuses for a page opened from disk.
   return "<!DOCTYPE html>\n<html>\n<head>\n<meta charset=\"utf-8\">\n<title>" +
          cases::xml_escaped(title) +
          "</title>\n<script src=\"x3dom.js\"></script>\n"
@@ -110,7 +93,7 @@ std::string html_page(const std::string& title, const std::vector<SceneSurface>&
          "</div>\n<x3d id=\"scene\" width=\"1000px\" height=\"650px\">\n  <Scene>\n"
          // X3DOM's own node: colours as given, not gamma-corrected, so the page shows the scale.
          "    <Environment gammaCorrectionDefault=\"none\"></Environment>\n" +
-         page_nodes +
+         nodes +
          "  </Scene>\n</x3d>\n<script>\nfunction show(name, on) {\n"
          "  document.getElementById(name).setAttribute('render', on ? 'true' : 'false');\n}\n"
          "</script>\n</body>\n</html>\n";
@@ -126,7 +109,7 @@ void write_x3d_scene(const std::filesystem::path& dir, const std::string& title,
     if (!std::filesystem::is_regular_file(x3dom / file))
       throw std::runtime_error("scene.html: " + (x3dom / file).string() +
                                " is missing (msfem's vendored X3DOM)");
-  const std::string nodes = scene_nodes(triangles, surfaces, max_mm, tool);
+  const std::string nodes = scene_nodes(triangles, surfaces, max_mm, tool, false);
   write_text_atomically(
       dir / "scene.x3d",
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -137,7 +120,9 @@ void write_x3d_scene(const std::filesystem::path& dir, const std::string& title,
           cases::xml_escaped(title) +
           "\"/>\n    <meta name=\"generator\" content=\"msfem\"/>\n  </head>\n  <Scene>\n" + nodes +
           "  </Scene>\n</X3D>\n");
-  write_text_atomically(dir / "scene.html", html_page(title, surfaces, nodes));
+  write_text_atomically(
+      dir / "scene.html",
+      html_page(title, surfaces, scene_nodes(triangles, surfaces, max_mm, tool, true)));
   for (const char* file : {"x3dom.js", "x3dom.css"})
     std::filesystem::copy_file(x3dom / file, dir / file,
                                std::filesystem::copy_options::overwrite_existing);

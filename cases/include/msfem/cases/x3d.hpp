@@ -25,9 +25,12 @@ Surface read_x3d_surface_bytes(const std::filesystem::path& file, const std::str
 
 /// A `<Shape DEF="def">` holding the surface as an IndexedFaceSet (solid false, every coordinate
 /// to 17 significant digits so it reads back exactly), with per-vertex colours (n x 3 in [0, 1])
-/// when `colours` has rows, and `appearance` (an <Appearance> element, or empty) before it.
+/// when `colours` has rows, and `appearance` (an <Appearance> element, or empty) before it. Every
+/// element has its end tag, so the same text is XML and HTML (which has no `<Name .../>`);
+/// `attributes` (e.g. an HTML page's id) go into the Shape's start tag.
 std::string x3d_shape(const std::string& def, const Eigen::MatrixX3d& points,
                       const Eigen::MatrixX3i& triangles, const Eigen::MatrixX3d& colours,
-                      const std::string& appearance, const std::string& indent);
+                      const std::string& appearance, const std::string& indent,
+                      const std::string& attributes = "");
 
 }  // namespace msfem::cases
