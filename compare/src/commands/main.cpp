@@ -49,6 +49,13 @@ const std::vector<CommandEntry>& commands() {
        "          [--no-cache] [--quiet]\n"
        "      fit spring-group stiffness to the FEM on training loads (DX,DY,DZ@DEPTH;...), check\n"
        "      on held-out loads; calibration.json, report.md, calibrated.prm"},
+      {"haptic", haptic_command,
+       "haptic CASE.prm [--path FILE] [--rate HZ] [--seconds S] [--set-at T:SECTION/KEY=VALUE]...\n"
+       "          [--out DIR] [--set K=V]... [--json] [--no-cache] [--quiet]\n"
+       "      replay a tool path (CSV t_s,x_m,y_m,z_m; default: press at the case's tool, slide\n"
+       "      10 mm, release) against each variant, the force rendered at HZ (1000) on a thread\n"
+       "      of its own; rate, deadline misses, tick times, the model's own rate and the force\n"
+       "      error against the FEM along the path: haptic.json, report.md, traces"},
       {"export-load", export_load_command,
        "export-load CASE.prm OUTDIR [--set K=V]...\n"
        "      what an outside simulator needs to reproduce each load: surface.vtu (the case's\n"

@@ -117,38 +117,61 @@ ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s
   return t;
 }
 
-/// Distance from x to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
-double distance_to_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+/// The point of the triangle (a, b, c) closest to x (Ericson, Real-Time Collision Detection, 5.1.5).
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
+                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = x - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return (x - a).norm();
+  if (d1 <= 0 && d2 <= 0) return a;
   const Eigen::Vector3d bp = x - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return (x - b).norm();
+  if (d3 >= 0 && d4 <= d3) return b;
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (x - (a + d1 / (d1 - d3) * ab)).norm();
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
   const Eigen::Vector3d cp = x - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return (x - c).norm();
+  if (d6 >= 0 && d5 <= d6) return c;
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (x - (a + d2 / (d2 - d6) * ac)).norm();
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (x - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
   const double denominator = 1.0 / (va + vb + vc);
-  return (x - (a + ab * vb * denominator + ac * vc * denominator)).norm();
+  return a + ab * vb * denominator + ac * vc * denominator;
 }
 
 /// The closest approach of the surface to `center`.
 double distance_to_surface(const cases::Surface& s, const Eigen::Vector3d& center) {
-  double nearest = std::numeric_limits<double>::infinity();
-  for (Eigen::Index t = 0; t < s.num_triangles(); ++t)
-    nearest = std::min(nearest, distance_to_triangle(center, s.vertices.row(s.triangles(t, 0)),
-                                                     s.vertices.row(s.triangles(t, 1)),
-                                                     s.vertices.row(s.triangles(t, 2))));
-  return nearest;
+  return (closest_surface_point(s, center).point - center).norm();
 }
+
+}  // namespace
+
+SurfacePoint closest_surface_point(const cases::Surface& s, const Eigen::Vector3d& x) {
+  SurfacePoint best;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index t = 0; t < s.num_triangles(); ++t) {
+    const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)).transpose();
+    const Eigen::Vector3d b = s.vertices.row(s.triangles(t, 1)).transpose();
+    const Eigen::Vector3d c = s.vertices.row(s.triangles(t, 2)).transpose();
+    const Eigen::Vector3d q = closest_point_on_triangle(x, a, b, c);
+    const double d = (q - x).squaredNorm();
+    if (!(d < nearest)) continue;
+    nearest = d;
+    best.point = q;
+    best.triangle = static_cast<int>(t);
+    // Barycentric weights of q (Ericson 3.4), for interpolating vertex values there.
+    const Eigen::Vector3d v0 = b - a, v1 = c - a, v2 = q - a;
+    const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1);
+    const double d20 = v2.dot(v0), d21 = v2.dot(v1), den = d00 * d11 - d01 * d01;
+    const double wb = den > 0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+    const double wc = den > 0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+    best.weights = {1.0 - wb - wc, wb, wc};
+  }
+  return best;
+}
+
+namespace {
 
 // A contact tool must start outside the body (touching it) and reach it at full depth: a sphere
 // already inside would be pushed out, not in, and one that misses compares nothing.

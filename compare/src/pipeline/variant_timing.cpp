@@ -112,6 +112,13 @@ void settle(Timing& t, TimedStepper& stepper, const BuiltVariant& variant,
 
 }  // namespace
 
+double timed_dt(const BuiltVariant& variant, const cases::TimingParameters& timing) {
+  if (timing.dt_s > 0) return timing.dt_s;
+  Timing t;
+  stable_step(t, *variant.model, timing.integrator, ms::initial_state(*variant.model));
+  return 0.5 * t.stable_dt_s;
+}
+
 Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& timing,
                     const Eigen::VectorXd& equilibrium, bool measure_settling, int threads) {
   const ms::MassSpringModel& model = *variant.model;

@@ -39,6 +39,10 @@ class SurfaceContactForceField : public ToolContact {
   const SphereTool& tool() const override { return tool_; }
   const std::vector<int>& nodes() const override { return nodes_; }
   double penalty_stiffness() const override { return pressure_penalty_ * mean_node_area_; }
+  std::shared_ptr<ToolContact> clone() const override {
+    return std::make_shared<SurfaceContactForceField>(*this);  // shares the rest-state k-d tree
+  }
+  void move_tool(const Eigen::Vector3d& center) override { tool_.center = center; }
   double pressure_penalty() const { return pressure_penalty_; }
   /// κ (Pa/m), finite and > 0 (ModelError otherwise).
   void set_pressure_penalty(double pressure_penalty);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "msfem/massspring/force_model.hpp"
@@ -37,6 +38,13 @@ class ToolContact : public ForceField {
   /// surface contact the pressure penalty times a mean node's area. Preconditioners and the node
   /// relaxation use it; the forces come from add_force.
   virtual double penalty_stiffness() const = 0;
+  /// A copy of this contact that its caller owns: a haptic loop puts it in its model's contact
+  /// slot (MassSpringModel::set_field) and moves its sphere between steps with move_tool, leaving
+  /// the field other copies of the model share untouched.
+  virtual std::shared_ptr<ToolContact> clone() const = 0;
+  /// Moves the sphere's centre (m). A stepper holding the field reads the new centre at its next
+  /// force call; only for a field no other thread is reading at the time.
+  virtual void move_tool(const Eigen::Vector3d& center) = 0;
 
   void add_dfdv_product(const Eigen::VectorXd&, const Eigen::VectorXd&,
                         Eigen::VectorXd&) const override {}
@@ -65,6 +73,10 @@ class SphereContactForceField : public ToolContact {
   const SphereTool& tool() const override { return tool_; }
   const std::vector<int>& nodes() const override { return nodes_; }
   double penalty_stiffness() const override { return penalty_; }
+  std::shared_ptr<ToolContact> clone() const override {
+    return std::make_shared<SphereContactForceField>(*this);
+  }
+  void move_tool(const Eigen::Vector3d& center) override { tool_.center = center; }
 
  private:
   Eigen::Matrix3d block(const Eigen::Vector3d& position, Linearisation mode) const;

@@ -23,6 +23,7 @@ int verify_command(const Arguments& args);   // msfem verify [--json]
 int regress_command(const Arguments& args);  // msfem regress [--baselines DIR] [CASE...] [--update]
 int export_network_command(const Arguments& args);  // msfem export-network CASE.prm OUTDIR
 int export_load_command(const Arguments& args);     // msfem export-load CASE.prm OUTDIR
+int haptic_command(const Arguments& args);  // msfem haptic CASE.prm [--path F] [--rate HZ]
 int calibrate_command(const Arguments& args);  // msfem calibrate CASE.prm [--variant V] [--fit G]
 
 }  // namespace msfem::compare

@@ -61,8 +61,9 @@ class Options {
             throw std::invalid_argument("option --" + key + " needs a value");
           value = args[++i];
         }
-        // A second --out or --threads would silently win over the first: only --set repeats.
-        if (values_.count(key) && key != "set")
+        // A second --out or --threads would silently win over the first: only --set and
+        // --set-at repeat.
+        if (values_.count(key) && key != "set" && key != "set-at")
           throw std::invalid_argument("option --" + key + " is given twice");
         values_[key].push_back(value);
       } else {

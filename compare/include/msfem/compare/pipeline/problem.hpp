@@ -71,6 +71,15 @@ Problem make_problem(const cases::CaseParameters& parameters);
 int farthest_vertex(const cases::Surface& surface, const Eigen::Vector3d& centroid,
                     const Eigen::Vector3d& direction);
 
+/// The point of a surface nearest a position: its triangle and the point's barycentric weights
+/// on that triangle's vertices.
+struct SurfacePoint {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int triangle = -1;
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+};
+SurfacePoint closest_surface_point(const cases::Surface& surface, const Eigen::Vector3d& x);
+
 /// The surface vertices a patch force pulls (empty without one): within its radius of the vertex
 /// farthest along its direction.
 std::vector<int> patch_vertices(const Problem& problem);

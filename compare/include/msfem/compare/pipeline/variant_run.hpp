@@ -132,4 +132,8 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
                     const Eigen::VectorXd& equilibrium, bool measure_settling = true,
                     int threads = 0);
 
+/// The step time_variant steps the case's integrator with: timing/dt, or half the stable step
+/// (implicit Euler: half of a 1 kHz loop's).
+double timed_dt(const BuiltVariant& variant, const cases::TimingParameters& timing);
+
 }  // namespace msfem::compare
