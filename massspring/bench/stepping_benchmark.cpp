@@ -150,6 +150,40 @@ double stream_triad_bandwidth(int threads, int repeats) {
   return best;
 }
 
+double triad_bandwidth_at(std::size_t bytes, int threads, int repeats) {
+  threads = std::max(threads, 1);
+  const std::size_t n = std::max<std::size_t>(bytes / (3 * sizeof(double)), 64 * threads);
+  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
+  const double pass_bytes = 3.0 * sizeof(double) * n;
+  const long passes = std::max(1L, static_cast<long>(2e9 / pass_bytes));  // ~30 ms at 60 GB/s
+  // Each thread's share stays in its own part of the caches, as a step's node blocks do; no
+  // barrier between passes, so this is the bandwidth alone, not the step's synchronisation.
+  auto sweep = [&](int part) {
+    const std::size_t first = n * part / threads, last = n * (part + 1) / threads;
+    for (long p = 0; p < passes; ++p) {
+      const double s = 3.0 + 1e-9 * static_cast<double>(p & 1);
+      for (std::size_t i = first; i < last; ++i)
+        a[i] = b[i] + s * c[i];
+      asm volatile("" : : "r"(a.data()) : "memory");  // every pass's stores happen
+    }
+  };
+  double best = 0.0;
+  for (int r = 0; r < std::max(repeats, 1); ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> team;
+    for (int t = 1; t < threads; ++t)
+      team.emplace_back(sweep, t);
+    sweep(0);
+    for (auto& t : team)
+      t.join();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = std::max(best, pass_bytes * static_cast<double>(passes) / seconds);
+  }
+  if (!(a[n / 2] > 6.9)) return 0.0;  // keeps the passes from being optimised away
+  return best;
+}
+
 State loaded_start(const MassSpringModel& model) {
   State start = initial_state(model);
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();

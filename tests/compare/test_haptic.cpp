@@ -22,9 +22,12 @@ using testing::run_msfem;
 using testing::TemporaryDirectory;
 
 const std::string case_file = std::string(MSFEM_CASES_DIR) + "/sphere_indent.prm";
-const std::vector<std::string> small = {"geometry/source=icosphere:2:0.05", "fem/degree=1",
-                                        "fem/error estimate=none",
-                                        "mass spring/variants=three_tier"};
+// Implicit Euler: under symplectic Euler three_tier's contact never settles on this sphere (msfem
+// run reports settled = false; the replay shows it bouncing at 5 Hz), and a held tool's force
+// must be steady for a change to show.
+const std::vector<std::string> small = {"fem/degree=1", "fem/error estimate=none",
+                                        "mass spring/variants=three_tier",
+                                        "timing/integrator=implicit_euler"};
 
 std::string small_options() {
   std::string s;
@@ -156,19 +159,20 @@ TEST(HapticChanges, ParsesSortsAndRefusesWhatCannotChangeWhileRunning) {
   refused("1 mass spring/damping ratio", "expected T:SECTION/KEY=VALUE");
 }
 
-// The replay as a user runs it: the tool pressed in 0.3 s and held; at 1.5 s the surface springs
-// are made three times stiffer, as from the seed's menu.
+// The replay as a user runs it: the tool pressed 4 mm in 0.3 s and held; at 1.5 s the surface
+// springs are made three times stiffer, as from the seed's menu (the force rises about 11 %).
 TEST(HapticReplay, RendersTheModelsForceAndShowsAChangeAtItsTime) {
   TemporaryDirectory dir;
   const compare::Problem problem = compare::make_problem(cases::read_case(case_file, small));
   const compare::ToolPlacement& tool = problem.tools.front();
+  const double depth = 0.004;
   const Eigen::Vector3d n = tool.outward_normal, above = tool.contact_point + 0.006 * n;
+  const Eigen::Vector3d pressed = tool.contact_point + (tool.radius - depth) * n;
   std::ostringstream csv;
   csv.precision(17);
   csv << "t_s,x_m,y_m,z_m\n0," << above.x() << ',' << above.y() << ',' << above.z() << '\n';
   for (double t : {0.3, 3.0})
-    csv << t << ',' << tool.pushed_center().x() << ',' << tool.pushed_center().y() << ','
-        << tool.pushed_center().z() << '\n';
+    csv << t << ',' << pressed.x() << ',' << pressed.y() << ',' << pressed.z() << '\n';
   const auto path = write(dir / "press.csv", csv.str());
   const auto out = dir / "haptic";
   const auto r = run_msfem("haptic " + case_file + small_options() + " --path " + path.string() +
@@ -209,20 +213,21 @@ TEST(HapticReplay, RendersTheModelsForceAndShowsAChangeAtItsTime) {
   };
   const double before = mean_over(1.0, 1.5), after = mean_over(2.0, 2.5);
   ASSERT_GT(before, 0.0);
-  EXPECT_GT(after, 1.2 * before) << "stiffer springs push the held tool harder";
+  EXPECT_GT(after, 1.05 * before) << "stiffer springs push the held tool harder";
   double first_moved = 1e9;
   for (const auto& [t, f] : push)
-    if (t >= 1.0 && std::abs(f - before) > 0.03 * before) {
+    if (t >= 1.0 && std::abs(f - before) > 0.02 * before) {
       first_moved = t;
       break;
     }
   EXPECT_GE(first_moved, 1.5) << "the force moved before the change";
-  EXPECT_LT(first_moved, 1.6) << "the change took too long to show";
+  EXPECT_LT(first_moved, 1.7) << "the change took too long to show";
 
   // Held still, the rendered force is the variant's own equilibrium there; the FEM it is measured
   // against is the FEM msfem run solves for the same tool.
   const auto run_out = dir / "run";
   ASSERT_EQ(run_msfem("run " + case_file + small_options() +
+                      " --set loads/tool/depth=" + std::to_string(depth) +
                       " --quiet --no-timing --no-curve --out " + run_out.string())
                 .exit_code,
             0);

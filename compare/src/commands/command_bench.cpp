@@ -33,7 +33,8 @@ nlohmann::json precision_json(const std::optional<massspring::PrecisionCompariso
 
 nlohmann::json to_json(const massspring::BenchmarkCase& c,
                        const massspring::SteppingBenchmarkResult& r,
-                       const massspring::SteppingBenchmarkOptions& options, double stream) {
+                       const massspring::SteppingBenchmarkOptions& options, double stream,
+                       double at_working_set) {
   const double explicit_bandwidth = r.explicit_bytes_per_step * r.explicit_steps_per_second;
   nlohmann::json warnings = c.network.warnings;
   for (const auto& note : r.notes)
@@ -65,6 +66,10 @@ nlohmann::json to_json(const massspring::BenchmarkCase& c,
           {"explicit_bytes_per_step", r.explicit_bytes_per_step},
           {"explicit_bytes_per_second", explicit_bandwidth},
           {"explicit_fraction_of_stream_bandwidth", stream > 0 ? explicit_bandwidth / stream : 0.0},
+          {"working_set_bytes", r.explicit_bytes_per_step},
+          {"working_set_triad_bytes_per_second", at_working_set},
+          {"fraction_of_working_set_roofline",
+           at_working_set > 0 ? explicit_bandwidth / at_working_set : 0.0},
           {"explicit_dt_s", r.explicit_dt},
           {"implicit_dt_s", options.implicit_dt},
           {"warnings", warnings}};
@@ -98,16 +103,27 @@ int bench_massspring(const Options& options) {
   // The roofline: a memory-bound step can go no faster than this machine streams its bytes.
   const double stream = massspring::stream_triad_bandwidth(bench_options.threads);
   if (!json) std::printf("stream triad bandwidth %.2f GB/s\n", 1e-9 * stream);
+  // The roofline at a working set: the triad at that size, on the stepper's threads. A step whose
+  // bytes fit the caches is held to the caches' bandwidth, not memory's.
+  nlohmann::json ladder = nlohmann::json::array();
+  for (const double megabytes : {0.25, 1.0, 4.0, 12.0, 32.0, 128.0}) {
+    const auto bytes = static_cast<std::size_t>(megabytes * 1e6);
+    const double rate = massspring::triad_bandwidth_at(bytes, bench_options.threads);
+    ladder.push_back({{"bytes", bytes}, {"triad_bytes_per_second", rate}});
+    if (!json) std::printf("triad at %7.2f MB: %7.2f GB/s\n", megabytes, 1e-9 * rate);
+  }
   nlohmann::json cases_json = nlohmann::json::array();
   for (const auto& c :
        massspring::benchmark_cases(brain_vertices, brain_triangles, !options.flag("no-10x"))) {
     const auto result = massspring::run_benchmark_case(c, bench_options);
-    cases_json.push_back(to_json(c, result, bench_options, stream));
+    const double at_working_set =
+        massspring::triad_bandwidth_at(result.explicit_bytes_per_step, result.threads);
+    cases_json.push_back(to_json(c, result, bench_options, stream, at_working_set));
     if (!json)
       std::printf(
           "%-18s %8d nodes %9d springs  explicit %9.0f steps/s (%.0f-%.0f)  naive %8.0f steps/s "
           "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)  float/double %.1e  explicit %.2f GB/s "
-          "(%.0f %% of stream)\n",
+          "(%.0f %% of stream, %.0f %% of the triad at its %.1f MB)\n",
           c.name.c_str(), result.nodes, result.springs, result.explicit_steps_per_second,
           result.explicit_spread.min, result.explicit_spread.max, result.naive_steps_per_second,
           result.naive_steps_per_second > 0.0
@@ -118,7 +134,11 @@ int bench_massspring(const Options& options) {
           1e-9 * result.explicit_bytes_per_step * result.explicit_steps_per_second,
           stream > 0
               ? 100.0 * result.explicit_bytes_per_step * result.explicit_steps_per_second / stream
-              : 0.0);
+              : 0.0,
+          at_working_set > 0 ? 100.0 * result.explicit_bytes_per_step *
+                                   result.explicit_steps_per_second / at_working_set
+                             : 0.0,
+          1e-6 * static_cast<double>(result.explicit_bytes_per_step));
   }
   if (json) {
     const nlohmann::json report = {{"benchmark", "massspring"},
@@ -127,6 +147,7 @@ int bench_massspring(const Options& options) {
                                    {"single_precision", bench_options.single_precision},
                                    {"seconds_per_sample", bench_options.seconds_per_sample},
                                    {"stream_triad_bytes_per_second", stream},
+                                   {"cache_ladder", ladder},
                                    {"samples", bench_options.samples},
                                    {"statistic",
                                     "median steps per second after warm-up; *_spread: min, "

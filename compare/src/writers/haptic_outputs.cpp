@@ -78,6 +78,12 @@ void write_trace(const HapticReplay& r, const std::filesystem::path& file) {
   write_text_atomically(file, out.str());
 }
 
+std::string fixed(double value, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << value;
+  return s.str();
+}
+
 // |F| against time: each variant's rendered force as a line, the FEM's quasi-static answers as
 // points with their error bars, the run-time changes as dashed verticals.
 std::filesystem::path force_time_plot(const HapticRun& run, const std::filesystem::path& file) {
@@ -94,8 +100,28 @@ std::filesystem::path force_time_plot(const HapticRun& run, const std::filesyste
       data << trace[i].t_s << ' ' << trace[i].force.norm() << '\n';
     data << "\n\n";
   }
-  commands << "set title 'Force on the tool along the replayed path' noenhanced\n"
-           << "set xlabel 'time (s)'\nset ylabel 'force on the tool (N)'\nset grid\n"
+  // The force's range at its 99.5th percentile: an explicit model's contact chatter would
+  // otherwise flatten the curves into the axis. The peaks clipped are stated in the title.
+  std::vector<double> magnitudes;
+  double fem_most = 0.0, peak = 0.0;
+  for (const PathForceError& e : run.variants.front().samples)
+    fem_most = std::max(fem_most, e.fem_force.norm());
+  for (const VariantAlongPath& v : run.variants)
+    for (const HapticTick& t : v.replay.trace)
+      magnitudes.push_back(t.force.norm());
+  std::sort(magnitudes.begin(), magnitudes.end());
+  if (!magnitudes.empty()) peak = magnitudes.back();
+  const double high = magnitudes.empty()
+                          ? 0.0
+                          : magnitudes[static_cast<std::size_t>(0.995 * (magnitudes.size() - 1))];
+  const double top = 1.3 * std::max(high, fem_most);
+  const bool clipped = top > 0 && peak > top;
+  commands << "set title 'Force on the tool along the replayed path"
+           << (clipped ? " (peaks up to " + fixed(peak, 2) + " N clipped)" : std::string())
+           << "' noenhanced\n"
+           << "set xrange [0:" << run.settings.seconds << "]\n";
+  if (top > 0) commands << "set yrange [0:" << top << "]\n";
+  commands << "set xlabel 'time (s)'\nset ylabel 'force on the tool (N)'\nset grid\n"
            << "set key top left noenhanced\n";
   for (const ParameterChange& c : run.changes)
     commands << "set arrow from " << c.t_s << ", graph 0 to " << c.t_s
@@ -107,12 +133,6 @@ std::filesystem::path force_time_plot(const HapticRun& run, const std::filesyste
              << variant_colour(i) << "' title '" << run.variants[i].replay.name << "'";
   commands << "\n";
   return detail::render(file, data.str(), commands.str());
-}
-
-std::string fixed(double value, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << value;
-  return s.str();
 }
 
 std::string report_markdown(const HapticRun& run, const std::string& plot) {

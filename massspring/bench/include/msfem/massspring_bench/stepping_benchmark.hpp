@@ -101,6 +101,13 @@ State perturbed_start(const MassSpringModel& model);
 /// three 64 MiB arrays (far beyond any cache), split over `threads` threads, best of `repeats`.
 double stream_triad_bandwidth(int threads, int repeats = 5);
 
+/// The triad's bandwidth (bytes per second) at a working set of `bytes` (its three arrays
+/// together), each of `threads` threads sweeping its own share again and again: what the machine
+/// can feed a step that touches that many bytes. Below the last-level cache it is the cache's
+/// bandwidth, not memory's (a 12 MB step fits a 32 MB L3, where the triad runs several times
+/// faster than from memory). Best of `repeats` runs of about 30 ms each.
+double triad_bandwidth_at(std::size_t bytes, int threads, int repeats = 5);
+
 /// Rest state with every free node moved 2 % of its distance from the free nodes' centroid outwards
 /// (a few millimetres on an organ): every spring loaded as a pressed organ's are, so that a
 /// precision comparison sees the displacements a simulator renders, not round-off of a state at
