@@ -8,17 +8,12 @@
 #include <vector>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/text.hpp"
 
 namespace msfem::cases {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string trim(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
-}
 
 // The words of a line with its comment removed and runs of blanks collapsed, as ParameterHandler
 // reads names ("set  youngs   modulus" is the key "youngs modulus").
@@ -27,7 +22,7 @@ std::string normalised(std::string line) {
   if (hash != std::string::npos) line.resize(hash);
   std::string out;
   bool blank = false;
-  for (char c : trim(line)) {
+  for (char c : trimmed(line)) {
     const bool space = c == ' ' || c == '\t';
     if (space && blank) continue;
     out += space ? ' ' : c;
@@ -46,7 +41,7 @@ bool starts_with_word(const std::string& line, const std::string& word) {
 std::string without_byte_order_mark(std::string text, const fs::path& file,
                                     const std::string& where) {
   if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
-  if (trim(text).empty()) throw InputError(where + file.string() + ": the case file is empty");
+  if (trimmed(text).empty()) throw InputError(where + file.string() + ": the case file is empty");
   return text;
 }
 
@@ -73,7 +68,7 @@ std::vector<std::pair<int, std::string>> logical_lines(const std::string& text) 
   while (std::getline(in, line)) {
     ++number;
     if (joined.empty()) first = number;
-    const std::string t = trim(line);
+    const std::string t = trimmed(line);
     if (!t.empty() && t.back() == '\\') {
       joined += t.substr(0, t.size() - 1);
       continue;
@@ -140,15 +135,15 @@ void scan_file(const fs::path& file, const std::string& text, Scan& scan) {
     const std::string line = normalised(raw);
     const std::string where = file.string() + ":" + std::to_string(number) + ": ";
     if (starts_with_word(line, "subsection")) {
-      scan.sections.push_back(trim(line.substr(10)));
+      scan.sections.push_back(trimmed(line.substr(10)));
       check_section(scan, where);
     } else if (starts_with_word(line, "end")) {
       if (!scan.sections.empty()) scan.sections.pop_back();  // deal.II reports the imbalance
     } else if (starts_with_word(line, "include")) {
-      scan_include(trim(line.substr(7)), where, scan);
+      scan_include(trimmed(line.substr(7)), where, scan);
     } else if (starts_with_word(line, "set")) {
       const auto eq = line.find('=');
-      const std::string key = trim(line.substr(3, eq == std::string::npos ? eq : eq - 3));
+      const std::string key = trimmed(line.substr(3, eq == std::string::npos ? eq : eq - 3));
       const std::string full = section_key(scan.sections, key);
       const auto [it, added] = scan.set_at.emplace(full, where.substr(0, where.size() - 2));
       if (!added)
@@ -166,7 +161,7 @@ std::string with_absolute_includes(const fs::path& file, const std::string& text
   for (std::string line; std::getline(in, line);) {
     const std::string t = normalised(line);
     if (starts_with_word(t, "include")) {
-      const fs::path p = trim(t.substr(7));
+      const fs::path p = trimmed(t.substr(7));
       if (p.is_relative()) line = "include " + (file.parent_path() / p).lexically_normal().string();
     }
     out << line << '\n';
@@ -183,7 +178,7 @@ std::set<std::string> subsection_paths(const std::string& printed_parameters) {
   for (std::string raw; std::getline(in, raw);) {
     const std::string line = normalised(raw);
     if (starts_with_word(line, "subsection")) {
-      stack.push_back(trim(line.substr(10)));
+      stack.push_back(trimmed(line.substr(10)));
       paths.insert(joined(stack));
     } else if (starts_with_word(line, "end") && !stack.empty()) {
       stack.pop_back();

@@ -12,15 +12,10 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/text.hpp"
 
 namespace msfem::cases {
 namespace {
-
-std::string trimmed(const std::string& text) {
-  const auto first = text.find_first_not_of(" \t");
-  if (first == std::string::npos) return "";
-  return text.substr(first, text.find_last_not_of(" \t") - first + 1);
-}
 
 bool is_name(const std::string& name) {
   if (name.empty()) return false;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/text.hpp"
 #include "voxel_volume.hpp"
 
 namespace msfem::cases {
@@ -22,12 +23,6 @@ std::string number(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", value);
   return text;
-}
-
-std::string trimmed(const std::string& text) {
-  const auto first = text.find_first_not_of(" \t");
-  if (first == std::string::npos) return "";
-  return text.substr(first, text.find_last_not_of(" \t") - first + 1);
 }
 
 bool parse_number(const std::string& text, double& value) {

@@ -5,15 +5,10 @@
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
+#include "msfem/cases/text.hpp"
 
 namespace msfem::cases {
 namespace {
-
-std::string trimmed(const std::string& text) {
-  const auto first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos) return "";
-  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
-}
 
 // Splits at `separator`, trimming each piece; a trailing empty piece is dropped ("a; b;").
 std::vector<std::string> pieces(const std::string& text, char separator) {

@@ -61,6 +61,9 @@ TEST(ToolPath, ReadsADeviceLogAndWritesItBackExactly) {
                           "0.001,0.1000000001,0.2,0.3,0.7071067811865476,0,0.7071067811865476,0\n");
   const compare::ToolPath path = compare::read_tool_path(file);
   EXPECT_TRUE(path.had_orientation());
+  // A spreadsheet's UTF-8 byte order mark before the header is not a column.
+  const auto bom = write(dir / "bom.csv", "\xEF\xBB\xBFt_s,x_m,y_m,z_m\n0,0,0,0\n1,1,0,0\n");
+  EXPECT_EQ(compare::read_tool_path(bom).times().size(), 2u);
   ASSERT_EQ(path.times().size(), 2u);
   EXPECT_EQ(path.centers()[1].x(), 0.1000000001);
   compare::write_tool_path(path, dir / "back.csv");
@@ -88,6 +91,7 @@ TEST(ToolPath, RefusesABadLogNamingTheLine) {
   refused("0,0,0,0\n1,0,0,0,1,0,0,0\n", "bad.csv:2: 8 columns where the rows above have 4");
   refused("t_s,x_m,y_m,z_m\n0,0,0,nan\n", "is not a finite number");
   refused("0,0,0,0\n", "needs two rows or more");
+  refused("O.5,0,0,0\n1,0,0,0\n2,0,0,0\n", "bad.csv:1: column 1 'O.5' is not a finite number");
 }
 
 class HapticPath : public ::testing::Test {
@@ -132,6 +136,11 @@ TEST_F(HapticPath, SamplesWhereTheToolTouchesAndRefusesAPathThatNeverDoes) {
   const compare::ToolPath away({0.0, 1.0},
                                {Eigen::Vector3d(0, 0, 0.2), Eigen::Vector3d(0.2, 0, 0)});
   EXPECT_THROW(compare::path_samples(problem(), away, 1.0, 8, "away.csv"), cases::InputError);
+  // Touching for a moment at either end only: no time the FEM is compared at presses.
+  const Eigen::Vector3d touch = path.at(1.5), off = path.at(0.0);
+  const compare::ToolPath taps({0.0, 0.01, 0.02, 9.98, 9.99, 10.0},
+                               {touch, off, off, off, off, touch});
+  EXPECT_THROW(compare::path_samples(problem(), taps, 10.0, 8, "taps.csv"), cases::InputError);
 }
 
 TEST(HapticChanges, ParsesSortsAndRefusesWhatCannotChangeWhileRunning) {
@@ -153,6 +162,10 @@ TEST(HapticChanges, ParsesSortsAndRefusesWhatCannotChangeWhileRunning) {
   };
   refused("1:material/youngs modulus=5000", "cannot change while the model runs");
   refused("4:mass spring/damping ratio=0.8", "not a number of seconds in [0, 3");
+  EXPECT_EQ(
+      compare::parse_parameter_changes({"3:mass spring/damping ratio=0.8"}, case_file, small, 3.0)
+          .size(),
+      1u);  // the last tick itself
   refused("x:mass spring/damping ratio=0.8", "the time 'x'");
   refused("1:mass spring/group scales=no_such_group:2", "no_such_group");
   refused("1:material/density=-5", "density");
@@ -265,6 +278,10 @@ TEST(HapticCommand, RefusesBadOptionsBeforeAnySolve) {
   refused("--path " + (dir / "missing.csv").string(), "missing.csv: cannot open the tool path");
   refused("--set-at '1:fem/degree=2'", "cannot change while the model runs");
   refused("--rate 1e3x", "--rate '1e3x'");
+  refused("--rate 10", "at least 50 Hz");
+  refused("--seconds 0.0001", "shorter than one tick");
+  refused("--rate 100000 --seconds 3600", "at most 10000000");
+  refused("--seconds 2 --set-at '2.5:mass spring/damping ratio=0.8'", "the replay's last tick");
 }
 
 }  // namespace

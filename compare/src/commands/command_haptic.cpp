@@ -17,6 +17,8 @@ namespace msfem::compare {
 namespace {
 
 constexpr int fem_samples = 8;
+constexpr double min_rate_hz = 50.0;
+constexpr double max_ticks = 1e7;  // 10 s at 1 MHz, 2.8 h at 1 kHz: a trace of 0.5 GB
 
 double positive_option(const Options& opt, const std::string& key, double fallback, double most) {
   const auto text = opt.value(key);
@@ -28,6 +30,25 @@ double positive_option(const Options& opt, const std::string& key, double fallba
     throw cases::InputError("--" + key + " '" + *text + "': expected a number in (0, " +
                             std::to_string(most) + "]");
   return value;
+}
+
+// --seconds, else the path's own length, in ticks the trace can hold.
+double seconds_to_replay(const Options& opt, const ToolPath& path, double rate_hz) {
+  const double seconds = positive_option(opt, "seconds", path.end() - path.start(), 3600.0);
+  const std::string what = opt.value("seconds")
+                               ? "--seconds " + *opt.value("seconds")
+                               : "--path " + *opt.value("path") + ": the path's length " +
+                                     std::to_string(seconds) + " s";
+  if (!opt.value("seconds") && seconds > 3600.0)
+    throw cases::InputError(what + " is over an hour (are its times in seconds?); give --seconds");
+  if (seconds * rate_hz > max_ticks)
+    throw cases::InputError(what + " at " + std::to_string(rate_hz) + " Hz is " +
+                            std::to_string(seconds * rate_hz) + " ticks; at most " +
+                            std::to_string(static_cast<long>(max_ticks)));
+  if (seconds * rate_hz < 1.0)
+    throw cases::InputError(what + " is shorter than one tick at " + std::to_string(rate_hz) +
+                            " Hz");
+  return seconds;
 }
 
 // The tool each variant is built with: the case's first (made frictionless: a replayed tool
@@ -118,6 +139,10 @@ int haptic_command(const Arguments& args) {
   run.case_file = case_file;
   run.fem_degree = parameters.fem.degree;
   run.settings.rate_hz = positive_option(opt, "rate", 1000.0, 100000.0);
+  if (run.settings.rate_hz < min_rate_hz)
+    throw cases::InputError("--rate " + *opt.value("rate") + ": at least " +
+                            std::to_string(static_cast<int>(min_rate_hz)) +
+                            " Hz (the force is compared over 50 ms windows of ticks)");
   if (!(parameters.loads.tool.radius_m > 0))
     throw cases::InputError(case_file.string() +
                             ": loads/tool/radius: the replayed tool is a "
@@ -130,10 +155,11 @@ int haptic_command(const Arguments& args) {
     run.notes.push_back(
         "The path's orientation quaternions were read and checked; a spherical "
         "tool looks the same in every orientation, so they change nothing.");
-  run.settings.seconds =
-      positive_option(opt, "seconds", run.path->end() - run.path->start(), 3600.0);
-  run.changes = parse_parameter_changes(opt.values("set-at"), case_file, opt.values("set"),
-                                        run.settings.seconds);
+  run.settings.seconds = seconds_to_replay(opt, *run.path, run.settings.rate_hz);
+  const double last_tick =
+      std::floor(run.settings.seconds * run.settings.rate_hz) / run.settings.rate_hz;
+  run.changes =
+      parse_parameter_changes(opt.values("set-at"), case_file, opt.values("set"), last_tick);
   run.samples = path_samples(problem, *run.path, run.settings.seconds, fem_samples,
                              opt.value("path") ? *opt.value("path") : case_file.string());
   if (!parameters.mass_spring.results.empty())

@@ -8,16 +8,13 @@
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface.hpp"
+#include "msfem/cases/text.hpp"
 #include "msfem/compare/pipeline/haptic.hpp"
 
 namespace msfem::compare {
 namespace {
 
-std::string trimmed(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  return s.substr(first, s.find_last_not_of(" \t\r") - first + 1);
-}
+using cases::trimmed;
 
 std::vector<std::string> fields_of(const std::string& line) {
   std::vector<std::string> fields;
@@ -93,6 +90,7 @@ ToolPath read_tool_path(const std::filesystem::path& csv) {
   std::size_t columns = 0;
   std::string line;
   for (int number_of_line = 1; std::getline(in, line); ++number_of_line) {
+    if (number_of_line == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
     line = trimmed(line);
     if (line.empty() || line[0] == '#') continue;
     const std::string where = csv.string() + ":" + std::to_string(number_of_line) + ": ";
@@ -101,7 +99,9 @@ ToolPath read_tool_path(const std::filesystem::path& csv) {
       throw cases::InputError(where + std::to_string(f.size()) +
                               " columns; a tool path row is t_s, x_m, y_m, z_m and optionally an "
                               "orientation quaternion qw, qx, qy, qz");
-    if (columns == 0 && times.empty() && !number(f[0])) {  // the header row
+    const bool no_numbers = std::none_of(
+        f.begin(), f.end(), [](const std::string& x) { return number(x).has_value(); });
+    if (columns == 0 && times.empty() && no_numbers) {  // the header row
       columns = f.size();
       continue;
     }
@@ -208,6 +208,11 @@ std::vector<PathSample> path_samples(const Problem& problem, const ToolPath& pat
     // Barely touching, the force is too small to measure an error against.
     if (tool.depth > 0.05 * deepest) samples.push_back({t, tool});
   }
+  if (samples.empty())
+    throw cases::InputError(path_name + ": the tool touches the surface only in passing (at " +
+                            std::to_string(first) + " s and " + std::to_string(last) +
+                            " s), never at the times the FEM is compared; replay a path that "
+                            "presses");
   return samples;
 }
 
@@ -230,7 +235,15 @@ VariantAlongPath measure_along_path(
         e.haptic_force += tick.force;
         ++ticks;
       }
-    if (ticks > 0) e.haptic_force /= ticks;
+    if (ticks > 0) {
+      e.haptic_force /= ticks;
+    } else if (!replay.trace.empty()) {  // ticks sparser than the window: the nearest one
+      e.haptic_force = std::min_element(replay.trace.begin(), replay.trace.end(),
+                                        [&](const HapticTick& a, const HapticTick& b) {
+                                          return std::abs(a.t_s - e.t_s) < std::abs(b.t_s - e.t_s);
+                                        })
+                           ->force;
+    }
     const double error = (e.haptic_force - e.fem_force).norm();
     squares += error * error;
     if (e.static_force) static_squares += (*e.static_force - e.fem_force).squaredNorm();

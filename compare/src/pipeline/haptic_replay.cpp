@@ -16,8 +16,8 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/pipeline/haptic.hpp"
 #include "msfem/compare/pipeline/progress.hpp"
-#include "msfem/massspring/fast_implicit_stepper.hpp"
-#include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/compare/pipeline/variant_stepper.hpp"
+#include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/modal_damping.hpp"
 
 namespace msfem::compare {
@@ -53,13 +53,16 @@ class LocalModelMailbox {
   void publish(const LocalContactModel& m) {
     const int w = 1 - current_.load(std::memory_order_relaxed);
     Slot& slot = slots_[w];
-    slot.sequence.fetch_add(1, std::memory_order_acq_rel);
+    // Odd before any value changes: the fence keeps the stores below from being seen before it.
+    const unsigned sequence = slot.sequence.load(std::memory_order_relaxed);
+    slot.sequence.store(sequence + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
     const std::array<double, 10> v = {{m.center.x(), m.center.y(), m.center.z(), m.force.x(),
                                        m.force.y(), m.force.z(), m.normal.x(), m.normal.y(),
                                        m.normal.z(), m.stiffness}};
     for (std::size_t i = 0; i < v.size(); ++i)
       slot.values[i].store(v[i], std::memory_order_relaxed);
-    slot.sequence.fetch_add(1, std::memory_order_release);
+    slot.sequence.store(sequence + 2, std::memory_order_release);
     current_.store(w, std::memory_order_release);
   }
   LocalContactModel read() const {
@@ -99,43 +102,6 @@ class DevicePosition {
 
  private:
   std::array<std::atomic<double>, 3> xyz_{};
-};
-
-// The case's integrator on the fast kernels, as msfem run times it.
-class ModelStepper {
- public:
-  ModelStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, int threads) {
-    const ms::State start = ms::initial_state(model);
-    if (kind == ms::IntegratorKind::implicit_euler) {
-      ms::FastImplicitOptions options;
-      options.threads = threads;
-      implicit_ = std::make_unique<ms::FastImplicitStepper>(model, options);
-      implicit_->set_state(start);
-      return;
-    }
-    ms::FastStepperOptions options;
-    options.threads = threads;
-    options.integrator = kind == ms::IntegratorKind::central_difference
-                             ? ms::IntegratorKind::symplectic_euler
-                             : kind;
-    explicit_ = std::make_unique<ms::FastExplicitStepper>(model, options);
-    explicit_->set_state(start);
-  }
-  void step(double dt, int count) {
-    if (explicit_) return explicit_->step(dt, count);
-    for (int i = 0; i < count; ++i)
-      implicit_->step(dt);
-  }
-  ms::State state() const { return explicit_ ? explicit_->state() : implicit_->state(); }
-  void update_parameters(const ms::MassSpringModel& model) {
-    if (explicit_) return explicit_->update_parameters(model);
-    implicit_->update_parameters(model);
-  }
-  const char* name() const { return explicit_ ? "fast_explicit" : "fast_implicit"; }
-
- private:
-  std::unique_ptr<ms::FastExplicitStepper> explicit_;
-  std::unique_ptr<ms::FastImplicitStepper> implicit_;
 };
 
 double group_factor(const cases::CaseParameters& p, const std::string& group) {
@@ -195,6 +161,7 @@ void haptic_loop(Shared& shared, const ToolPath& path, const HapticSettings& set
   std::vector<double> latency_ms(static_cast<std::size_t>(ticks));
   out.trace.resize(static_cast<std::size_t>(ticks));
   int done = 0;
+  auto last_finished = shared.start;
   for (int i = 0; i < ticks && !shared.stop.load(std::memory_order_relaxed); ++i, ++done) {
     const auto due = shared.start + std::chrono::duration_cast<Clock::duration>(i * period);
     std::this_thread::sleep_until(due);
@@ -203,6 +170,7 @@ void haptic_loop(Shared& shared, const ToolPath& path, const HapticSettings& set
     shared.device.store(c);
     const Eigen::Vector3d force = shared.mailbox.read().render(c);
     const auto finished = Clock::now();
+    last_finished = finished;
     out.trace[static_cast<std::size_t>(i)] = {t, c, force};
     const double late = std::chrono::duration<double>(finished - due).count();
     latency_ms[static_cast<std::size_t>(i)] = 1e3 * late;
@@ -215,7 +183,9 @@ void haptic_loop(Shared& shared, const ToolPath& path, const HapticSettings& set
   out.ticks = done;
   out.trace.resize(static_cast<std::size_t>(done));
   latency_ms.resize(static_cast<std::size_t>(done));
-  out.rate_hz = done / std::max(seconds_since(shared.start), 1e-9);
+  // Ticks after the first over the time from the first one's due time to the last one's end.
+  const double span = std::chrono::duration<double>(last_finished - shared.start).count();
+  out.rate_hz = done > 1 && span > 0 ? (done - 1) / span : 0.0;
   out.tick = {percentile(latency_ms, 0.5), percentile(latency_ms, 0.99),
               latency_ms.empty() ? 0.0 : *std::max_element(latency_ms.begin(), latency_ms.end())};
 }
@@ -223,7 +193,7 @@ void haptic_loop(Shared& shared, const ToolPath& path, const HapticSettings& set
 // The model loop: steps to keep up with the wall clock (never more than half a millisecond's
 // worth per batch, so that the tool moves with the device), then hands over a local model.
 void model_loop(Shared& shared, BuiltVariant& variant, ms::ToolContact& contact,
-                ModelStepper& stepper, double dt, const cases::CaseParameters& parameters,
+                VariantStepper& stepper, double dt, const cases::CaseParameters& parameters,
                 const std::vector<ParameterChange>& changes, HapticReplay& out) {
   ms::MassSpringModel& model = *variant.model;
   const double max_lag_s = 0.02;  // a model this far behind drops the debt: it runs slow motion
@@ -252,7 +222,7 @@ void model_loop(Shared& shared, BuiltVariant& variant, ms::ToolContact& contact,
     const int batch_cap = std::max(1, static_cast<int>(5e-4 / step_s));
     const int count = std::clamp(static_cast<int>(debt / dt), 1, batch_cap);
     const auto batch_start = Clock::now();
-    stepper.step(dt, count);
+    stepper.advance(dt, count);
     const double batch_s = seconds_since(batch_start);
     busy_s += batch_s;
     step_s = batch_s / count;
@@ -263,8 +233,9 @@ void model_loop(Shared& shared, BuiltVariant& variant, ms::ToolContact& contact,
     m.center = c;
     m.force = ms::contact_reaction_force(model, s.x);
     if (!m.force.allFinite() || !s.x.allFinite())
-      throw std::runtime_error("variant " + variant.name + " diverged during the replay at t = " +
-                               std::to_string(now) + " s (dt " + std::to_string(dt) + " s)");
+      throw ms::DivergenceError("variant " + variant.name + " diverged during the replay at t = " +
+                                    std::to_string(now) + " s (dt " + std::to_string(dt) + " s)",
+                                dt, 0.5 * dt);
     if (m.force.norm() > 0.0) m.normal = m.force.normalized();
     if (have_last) {
       if (!(m.force.norm() > 0.0)) m.normal = last.normal;
@@ -299,7 +270,7 @@ const std::vector<std::string>& changeable_keys() {
 std::vector<ParameterChange> parse_parameter_changes(const std::vector<std::string>& options,
                                                      const std::filesystem::path& case_file,
                                                      std::vector<std::string> sets,
-                                                     double seconds) {
+                                                     double last_tick_s) {
   std::vector<ParameterChange> changes;
   for (const std::string& option : options) {
     const std::string what = "--set-at '" + option + "'";
@@ -312,10 +283,10 @@ std::vector<ParameterChange> parse_parameter_changes(const std::vector<std::stri
     const std::string time = option.substr(0, colon);
     change.t_s = std::strtod(time.c_str(), &end);
     if (time.empty() || end != time.c_str() + time.size() || !std::isfinite(change.t_s) ||
-        change.t_s < 0 || change.t_s >= seconds)
+        change.t_s < 0 || change.t_s > last_tick_s)
       throw cases::InputError(what + ": the time '" + time +
-                              "' is not a number of seconds in [0, " + std::to_string(seconds) +
-                              ") (the replay's length)");
+                              "' is not a number of seconds in [0, " + std::to_string(last_tick_s) +
+                              "] (the replay's last tick)");
     change.key = option.substr(colon + 1, equals - colon - 1);
     change.value = option.substr(equals + 1);
     const auto& keys = changeable_keys();
@@ -344,23 +315,24 @@ std::vector<ParameterChange> parse_parameter_changes(const std::vector<std::stri
   return changes;
 }
 
-HapticReplay replay_variant(BuiltVariant& variant, const cases::CaseParameters& parameters,
-                            const ToolPath& path, const HapticSettings& settings,
-                            const std::vector<ParameterChange>& changes) {
+namespace {
+
+// One replay at model step dt, from rest, the tool at the path's start.
+HapticReplay replay_once(BuiltVariant& variant, const cases::CaseParameters& parameters,
+                         const ToolPath& path, const HapticSettings& settings,
+                         const std::vector<ParameterChange>& changes, double dt) {
   ms::MassSpringModel& model = *variant.model;
-  if (!model.contact())
-    throw std::logic_error("replay_variant: the variant was built without its tool's contact");
   HapticReplay out;
   out.name = variant.name;
   out.integrator = ms::to_string(parameters.timing.integrator);
-  // The step msfem run times, found with the tool at the case's full depth (the stiffest contact).
-  out.model_dt_s = timed_dt(variant, parameters.timing);
+  out.model_dt_s = dt;
   const std::shared_ptr<ms::ToolContact> contact = model.contact()->clone();
   contact->move_tool(path.at(path.start()));
   model.set_field(ms::MassSpringModel::contact_field, contact);
   const int cores = static_cast<int>(std::max(2u, std::thread::hardware_concurrency()));
   out.model_threads = settings.model_threads > 0 ? settings.model_threads : std::min(2, cores - 1);
-  ModelStepper stepper(model, parameters.timing.integrator, out.model_threads);
+  VariantStepper stepper(model, parameters.timing.integrator, ms::initial_state(model),
+                         out.model_threads);
   out.stepper = stepper.name();
 
   Shared shared;
@@ -368,16 +340,61 @@ HapticReplay replay_variant(BuiltVariant& variant, const cases::CaseParameters& 
   shared.mailbox.publish(
       {path.at(path.start()), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.0});
   shared.start = Clock::now() + std::chrono::milliseconds(20);  // both threads up before tick 0
-  std::thread haptic([&] { haptic_loop(shared, path, settings, out); });
+  std::exception_ptr haptic_failure;
+  std::thread haptic([&] {
+    try {
+      haptic_loop(shared, path, settings, out);
+    } catch (...) {
+      haptic_failure = std::current_exception();
+      shared.stop.store(true);
+    }
+  });
   try {
-    model_loop(shared, variant, *contact, stepper, out.model_dt_s, parameters, changes, out);
+    model_loop(shared, variant, *contact, stepper, dt, parameters, changes, out);
   } catch (...) {
     shared.failure = std::current_exception();
     shared.stop.store(true);
   }
   haptic.join();
   if (shared.failure) std::rethrow_exception(shared.failure);
+  if (haptic_failure) std::rethrow_exception(haptic_failure);
   return out;
+}
+
+}  // namespace
+
+HapticReplay replay_variant(BuiltVariant& variant, const cases::CaseParameters& parameters,
+                            const ToolPath& path, const HapticSettings& settings,
+                            const std::vector<ParameterChange>& changes) {
+  if (!variant.model->contact())
+    throw std::logic_error("replay_variant: the variant was built without its tool's contact");
+  // The step msfem run times, found with the tool at the case's full depth (the stiffest
+  // contact), and no larger than what the model after each --set-at change keeps stable.
+  const ms::MassSpringModel original = *variant.model;
+  double dt = timed_dt(original, parameters.timing);
+  if (parameters.timing.dt_s <= 0 &&
+      parameters.timing.integrator != ms::IntegratorKind::implicit_euler) {
+    ms::MassSpringModel changed = original;
+    const cases::CaseParameters* before = &parameters;
+    for (const ParameterChange& change : changes) {
+      apply_change(changed, variant.spec, *before, change.after);
+      before = &change.after;
+      dt = std::min(dt, timed_dt(changed, parameters.timing));
+    }
+  }
+  // As msfem run does: the stable step is bisected on the generic integrator; the fast kernels
+  // under a moving contact may need half of it. Halve and replay again, at most twice.
+  for (int attempt = 0;; ++attempt) {
+    try {
+      HapticReplay out = replay_once(variant, parameters, path, settings, changes, dt);
+      out.halvings = attempt;
+      return out;
+    } catch (const ms::DivergenceError&) {
+      if (parameters.timing.dt_s > 0 || attempt == 2) throw;
+      *variant.model = original;
+      dt *= 0.5;
+    }
+  }
 }
 
 }  // namespace msfem::compare

@@ -7,6 +7,7 @@
 
 #include "msfem/compare/pipeline/progress.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
+#include "msfem/compare/pipeline/variant_stepper.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
@@ -17,47 +18,6 @@ namespace msfem::compare {
 namespace {
 
 namespace ms = msfem::massspring;
-
-// The stepper timed: FastExplicitStepper for symplectic Euler and central difference (its
-// symplectic Euler with velocities read at half steps is the leapfrog form of central difference:
-// one force evaluation per step, the same stable step), explicit Euler and RK4, and
-// FastImplicitStepper for implicit Euler (with the haptic CG settings msfem bench times), each with
-// the model's force fields (the tool's contact, volume preservation): every integrator the case
-// language offers runs on the fast kernels, the code a simulator would run.
-class TimedStepper {
- public:
-  TimedStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind, const ms::State& start,
-               int threads) {
-    if (kind == ms::IntegratorKind::implicit_euler) {
-      ms::FastImplicitOptions options;
-      if (threads > 0) options.threads = std::min(options.threads, threads);
-      implicit_ = std::make_unique<ms::FastImplicitStepper>(model, options);
-      implicit_->set_state(start);
-      return;
-    }
-    ms::FastStepperOptions options;
-    if (threads > 0) options.threads = std::min(options.threads, threads);
-    options.integrator = kind == ms::IntegratorKind::central_difference
-                             ? ms::IntegratorKind::symplectic_euler
-                             : kind;
-    explicit_ = std::make_unique<ms::FastExplicitStepper>(model, options);
-    explicit_->set_state(start);
-  }
-
-  void advance(double dt, int count) {
-    if (explicit_) return explicit_->step(dt, count);
-    for (int i = 0; i < count; ++i)
-      implicit_->step(dt);
-  }
-
-  ms::State state() const { return explicit_ ? explicit_->state() : implicit_->state(); }
-
-  const char* name() const { return explicit_ ? "fast_explicit" : "fast_implicit"; }
-
- private:
-  std::unique_ptr<ms::FastExplicitStepper> explicit_;
-  std::unique_ptr<ms::FastImplicitStepper> implicit_;
-};
 
 // The largest step the integrator keeps bounded, by bisection about the predicted one; for an
 // unconditionally stable one the step a haptic loop uses (1 kHz).
@@ -73,7 +33,7 @@ void stable_step(Timing& t, const ms::MassSpringModel& model, ms::IntegratorKind
 }
 
 // Steps per second: the median of five batches after a warm-up.
-double median_rate(TimedStepper& stepper, double dt, int steps) {
+double median_rate(VariantStepper& stepper, double dt, int steps) {
   const int batches = 5;
   const int per_batch = std::max(1, steps / batches);
   stepper.advance(dt, std::max(1, per_batch / 4));
@@ -88,7 +48,7 @@ double median_rate(TimedStepper& stepper, double dt, int steps) {
 }
 
 // Wall time from rest, with the load applied, to within 1 % of the static equilibrium's travel.
-void settle(Timing& t, TimedStepper& stepper, const BuiltVariant& variant,
+void settle(Timing& t, VariantStepper& stepper, const BuiltVariant& variant,
             const Eigen::VectorXd& x_rest, const Eigen::VectorXd& equilibrium) {
   const double travel = (equilibrium - x_rest).norm();
   const int stride = 20;
@@ -112,10 +72,48 @@ void settle(Timing& t, TimedStepper& stepper, const BuiltVariant& variant,
 
 }  // namespace
 
-double timed_dt(const BuiltVariant& variant, const cases::TimingParameters& timing) {
+VariantStepper::VariantStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind,
+                               const ms::State& start, int threads) {
+  if (kind == ms::IntegratorKind::implicit_euler) {
+    ms::FastImplicitOptions options;
+    if (threads > 0) options.threads = std::min(options.threads, threads);
+    implicit_ = std::make_unique<ms::FastImplicitStepper>(model, options);
+    implicit_->set_state(start);
+    return;
+  }
+  ms::FastStepperOptions options;
+  if (threads > 0) options.threads = std::min(options.threads, threads);
+  options.integrator =
+      kind == ms::IntegratorKind::central_difference ? ms::IntegratorKind::symplectic_euler : kind;
+  explicit_ = std::make_unique<ms::FastExplicitStepper>(model, options);
+  explicit_->set_state(start);
+}
+
+VariantStepper::~VariantStepper() = default;
+
+void VariantStepper::advance(double dt, int count) {
+  if (explicit_) return explicit_->step(dt, count);
+  for (int i = 0; i < count; ++i)
+    implicit_->step(dt);
+}
+
+ms::State VariantStepper::state() const {
+  return explicit_ ? explicit_->state() : implicit_->state();
+}
+
+void VariantStepper::update_parameters(const ms::MassSpringModel& model) {
+  if (explicit_) return explicit_->update_parameters(model);
+  implicit_->update_parameters(model);
+}
+
+const char* VariantStepper::name() const {
+  return explicit_ ? "fast_explicit" : "fast_implicit";
+}
+
+double timed_dt(const ms::MassSpringModel& model, const cases::TimingParameters& timing) {
   if (timing.dt_s > 0) return timing.dt_s;
   Timing t;
-  stable_step(t, *variant.model, timing.integrator, ms::initial_state(*variant.model));
+  stable_step(t, model, timing.integrator, ms::initial_state(model));
   return 0.5 * t.stable_dt_s;
 }
 
@@ -133,7 +131,7 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
   // diverge at half that step. Such a step bounds the timed code's stable step: halve and retry.
   for (int attempt = 0;; ++attempt) {
     try {
-      TimedStepper stepper(model, kind, start, threads);
+      VariantStepper stepper(model, kind, start, threads);
       t.stepper = stepper.name();
       if (measure_settling) settle(t, stepper, variant, start.x, equilibrium);
       t.steps_per_second = median_rate(stepper, t.dt_s, timing.steps);

@@ -53,6 +53,7 @@ json variant_json(const VariantAlongPath& v) {
           {"stepper", r.stepper},
           {"model_threads", r.model_threads},
           {"model_dt_s", r.model_dt_s},
+          {"model_dt_halvings", r.halvings},
           {"model_rate_hz", r.model_rate_hz},
           {"model_capacity_hz", r.model_capacity_hz},
           {"model_busy_fraction", r.model_busy_fraction},

@@ -56,7 +56,7 @@ ToolPlacement placement_at(const Problem& problem, const Eigen::Vector3d& center
 
 /// Where the FEM answers along the path: up to `count` times evenly spread over the span the tool
 /// touches the rest surface (in [0, seconds]), each with its placement. Throws cases::InputError
-/// naming `path_name` when the tool never reaches the surface.
+/// naming `path_name` when the tool never reaches the surface or touches it too briefly for any.
 struct PathSample {
   double t_s = 0.0;
   ToolPlacement tool;
@@ -74,14 +74,15 @@ struct ParameterChange {
 /// The case keys a replay can change while it runs.
 const std::vector<std::string>& changeable_keys();
 /// Parses `--set-at T:KEY=VALUE` options against the case (each value checked as the case file
-/// would check it), sorted by time. Throws cases::InputError naming the option at fault.
+/// would check it, T in [0, last_tick_s]), sorted by time. Throws cases::InputError naming the
+/// option at fault.
 std::vector<ParameterChange> parse_parameter_changes(const std::vector<std::string>& options,
                                                      const std::filesystem::path& case_file,
                                                      std::vector<std::string> sets, double seconds);
 
 struct HapticSettings {
   double rate_hz = 1000.0;
-  double seconds = 0.0;  ///< replay length (the path's end when ≤ 0)
+  double seconds = 0.0;  ///< replay length
   /// Threads the model steps on; the haptic thread has a core of its own (0: the cores less one).
   int model_threads = 0;
 };
@@ -118,6 +119,7 @@ struct HapticReplay {
   double model_update_hz = 0.0;      ///< local contact models handed to the haptic thread per s
   double realtime_factor = 0.0;      ///< simulated over wall seconds
   int model_threads = 0;
+  int halvings = 0;  ///< times the model's step was halved after it diverged (at most 2)
   std::vector<std::pair<double, std::string>> changes_applied;  ///< wall time, KEY=VALUE
   std::vector<HapticTick> trace;
 };

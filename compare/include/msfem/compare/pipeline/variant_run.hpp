@@ -134,6 +134,6 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
 
 /// The step time_variant steps the case's integrator with: timing/dt, or half the stable step
 /// (implicit Euler: half of a 1 kHz loop's).
-double timed_dt(const BuiltVariant& variant, const cases::TimingParameters& timing);
+double timed_dt(const massspring::MassSpringModel& model, const cases::TimingParameters& timing);
 
 }  // namespace msfem::compare
