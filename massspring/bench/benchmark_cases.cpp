@@ -124,6 +124,7 @@ std::vector<BenchmarkCase> benchmark_cases(const std::optional<Eigen::MatrixX3d>
 
 SteppingBenchmarkResult run_benchmark_case(const BenchmarkCase& benchmark_case,
                                            const SteppingBenchmarkOptions& options) {
+  if (benchmark_case.model) return run_stepping_benchmark(*benchmark_case.model, options);
   MassSpringModel model(benchmark_case.network);
   SteppingBenchmarkResult result;
   if (benchmark_case.volume_preservation) {

@@ -95,10 +95,10 @@ class ImplicitFields {
     for (const Node& n : nodes_)
       blocks[static_cast<std::size_t>(n.node)].setZero();
     for (std::size_t k = 0; k < fields_.size(); ++k) {
-      fields_[k]->add_force_part(x_, v_, b, member, members);
       tangents_[k]->set_part(member, members);
-      tangents_[k]->add_product_part(hv_, b, member, members);
-      tangents_[k]->add_product_part(hdv_, a, member, members);
+      if (!tangents_[k]->add_force_part(b, member, members))
+        fields_[k]->add_force_part(x_, v_, b, member, members);
+      tangents_[k]->add_product_pair_part(hv_, b, hdv_, a, member, members);
       if (member == 0) fields_[k]->add_dfdv_product(x_, dv_, a);
       tangents_[k]->add_diagonal_blocks_part(h * h, h, blocks, member, members);
     }

@@ -59,34 +59,43 @@ TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
   EXPECT_LE(moment.norm(), 1e-12 * f.norm() * 0.05);
 }
 
-// The kept tangent (each element's gradient stored once) multiplies, and gives the diagonal
-// blocks, as the definite calls that recompute the gradients, in one part and shared by three, and
-// follows the state it was made with when set again.
-TEST(VolumeForceField, KeptTangentMultipliesAsTheRecomputedProduct) {
-  const SpringNetwork network = three_tier_sphere(1);
-  const VolumeForceField volume = shell_prisms(network, 8000.0);
-  Eigen::VectorXd x = perturbed(flatten(network.rest_positions), 0.004, 3);
-  const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
-  const Eigen::VectorXd dx = perturbed(Eigen::VectorXd::Zero(x.size()), 0.001, 5);
+// The kept tangent (each element's gradient and volume stored once) multiplies, gives the diagonal
+// blocks and the force, as the definite calls that recompute them, in one part and shared by three,
+// and follows the state it was made with when set again.
+void expect_kept_tangent_as_recomputed(const VolumeForceField& volume, Eigen::VectorXd x) {
+  const Eigen::Index n = x.size();
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd dx = perturbed(Eigen::VectorXd::Zero(n), 0.001, 5);
+  const Eigen::VectorXd dx2 = perturbed(Eigen::VectorXd::Zero(n), 0.001, 9);
   const auto tangent = volume.tangent(x, v, Linearisation::definite);
+  const auto close = [](const Eigen::VectorXd& got, const Eigen::VectorXd& want) {
+    return (got - want).norm() <= 1e-12 * want.norm() && want.norm() > 0.0;
+  };
   for (int round = 0; round < 2; ++round) {
-    Eigen::VectorXd expected = Eigen::VectorXd::Zero(x.size());
+    Eigen::VectorXd expected = Eigen::VectorXd::Zero(n), expected2 = expected, force = expected;
     volume.add_dfdx_product(x, v, dx, expected, Linearisation::definite);
-    ASSERT_GT(expected.norm(), 0.0);
+    volume.add_dfdx_product(x, v, dx2, expected2, Linearisation::definite);
+    volume.add_force(x, v, force);
     for (const int parts : {1, 3}) {
-      Eigen::VectorXd product = Eigen::VectorXd::Zero(x.size());
+      Eigen::VectorXd product = Eigen::VectorXd::Zero(n), pair1 = product, pair2 = product,
+                      kept_force = product;
       for (int part = 0; part < parts; ++part) {
         tangent->set_part(part, parts);
         tangent->add_product_part(dx, product, part, parts);
+        tangent->add_product_pair_part(dx, pair1, dx2, pair2, part, parts);
+        EXPECT_TRUE(tangent->add_force_part(kept_force, part, parts));
       }
-      EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm()) << parts << " " << round;
-      std::vector<Eigen::Matrix3d> blocks(network.num_nodes(), Eigen::Matrix3d::Zero()),
-          recomputed = blocks;
+      EXPECT_TRUE(close(product, expected)) << parts << " " << round;
+      EXPECT_TRUE(close(pair1, expected)) << parts << " " << round;
+      EXPECT_TRUE(close(pair2, expected2)) << parts << " " << round;
+      EXPECT_TRUE(close(kept_force, force)) << parts << " " << round;
+      const int nodes = static_cast<int>(n / 3);
+      std::vector<Eigen::Matrix3d> blocks(nodes, Eigen::Matrix3d::Zero()), recomputed = blocks;
       for (int part = 0; part < parts; ++part)
         tangent->add_diagonal_blocks_part(2.0, 3.0, blocks, part, parts);
       volume.add_diagonal_blocks(x, v, 2.0, 3.0, recomputed, Linearisation::definite);
       double worst = 0.0, largest = 0.0;
-      for (int i = 0; i < network.num_nodes(); ++i) {
+      for (int i = 0; i < nodes; ++i) {
         worst = std::max(worst, (blocks[i] - recomputed[i]).norm());
         largest = std::max(largest, recomputed[i].norm());
       }
@@ -95,6 +104,24 @@ TEST(VolumeForceField, KeptTangentMultipliesAsTheRecomputedProduct) {
     }
     x = perturbed(x, 0.002, 7);  // the next round's state, read through the same tangent
   }
+}
+
+TEST(VolumeForceField, KeptTangentMultipliesAsTheRecomputedProduct) {
+  const SpringNetwork network = three_tier_sphere(1);
+  expect_kept_tangent_as_recomputed(shell_prisms(network, 8000.0),
+                                    perturbed(flatten(network.rest_positions), 0.004, 3));
+  // Lone tetrahedra (tet_edges' elements, which take their own path): a cube's six, around its
+  // diagonal, with a seventh node only springs would hold.
+  Eigen::MatrixX3d p(9, 3);
+  p << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1, 2, 2, 2;
+  p *= 0.01;
+  Eigen::MatrixX4i tets(6, 4);
+  tets << 0, 1, 3, 7, 0, 3, 2, 7, 0, 2, 6, 7, 0, 6, 4, 7, 0, 4, 5, 7, 0, 5, 1, 7;
+  const VolumeElements elements = tetrahedron_elements(p, tets, 5000.0);
+  for (int t = 0; t < 6; ++t)
+    ASSERT_NEAR(std::abs(elements.rest_volume[t]), 1e-6 / 6.0, 1e-18) << t;
+  expect_kept_tangent_as_recomputed(VolumeForceField(9, elements),
+                                    perturbed(flatten(p), 0.002, 11));
 }
 
 TEST(VolumeForceField, PrismsRespondAlikeWhicheverCornerTheirTrianglesStartAt) {

@@ -1,5 +1,6 @@
 // msfem bench massspring: steps per second of the mass-spring steppers on the seed sphere, the
 // brain and ten times the brain, against the naive scalar loop run in the same process.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -8,15 +9,64 @@
 #include <stdexcept>
 #include <thread>
 
+#include "msfem/cases/case_parameters.hpp"
+#include "msfem/cases/errors.hpp"
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/fem_run.hpp"
+#include "msfem/compare/pipeline/variant_run.hpp"
 #include "msfem/massspring_bench/benchmark_cases.hpp"
 
 namespace msfem::compare {
 namespace {
 
 constexpr const char* kBrainFile = "brain_icbm152_lh_9177_mm.obj";
+
+// The one spring model whose error falls with resolution: tet_edges with volume preservation, on
+// the seed sphere's mesh exactly as `msfem sweep cases/sphere_indent_bonded.prm
+// --volume-preservation on` builds and times it (its FEM mesh, supports and bonded tool at depth),
+// so that the two commands' figures are of one model.
+massspring::BenchmarkCase accurate_sphere_case() {
+  const std::filesystem::path file =
+      std::filesystem::path(MSFEM_DEFAULT_CASES_DIR) / "sphere_indent_bonded.prm";
+  const cases::CaseParameters parameters = cases::read_case(
+      file, {"mass spring/variants=tet_edges", "mass spring/volume preservation=true"});
+  const Problem problem = make_problem(parameters);
+  const fem_reference::VolumeMesh mesh = mesh_problem(problem);
+  BuiltVariant built =
+      build_variant(cases::Variant::tet_edges, problem, mesh,
+                    problem.tools.empty() ? std::nullopt : std::optional(problem.tools.front()));
+  massspring::BenchmarkCase c;
+  c.name = "seed_sphere_tet_edges_volume";
+  c.description = "tet_edges with volume preservation on the seed sphere's FEM mesh (" +
+                  file.filename().string() + ", its bonded tool at depth)";
+  c.network = built.model->network();
+  c.volume_preservation = true;
+  c.model = std::move(built.model);
+  return c;
+}
+
+// The cases the command runs: every one, or those --cases names (unknown names refused).
+std::vector<massspring::BenchmarkCase> chosen_cases(const Options& options,
+                                                    std::vector<massspring::BenchmarkCase> all) {
+  all.push_back(accurate_sphere_case());
+  const std::vector<std::string> wanted = options.list("cases");
+  if (wanted.empty()) return all;
+  std::vector<massspring::BenchmarkCase> chosen;
+  for (const std::string& name : wanted) {
+    auto it = std::find_if(all.begin(), all.end(), [&](const auto& c) { return c.name == name; });
+    if (it == all.end()) {
+      std::string known;
+      for (const auto& c : all)
+        known += (known.empty() ? "" : ", ") + c.name;
+      throw cases::InputError("--cases: no bench case '" + name + "' (" + known + ")");
+    }
+    chosen.push_back(std::move(*it));
+    all.erase(it);
+  }
+  return chosen;
+}
 
 nlohmann::json spread_json(const massspring::RateSpread& s) {
   if (!(s.median > 0)) return nullptr;  // not run
@@ -113,8 +163,9 @@ int bench_massspring(const Options& options) {
     if (!json) std::printf("triad at %7.2f MB: %7.2f GB/s\n", megabytes, 1e-9 * rate);
   }
   nlohmann::json cases_json = nlohmann::json::array();
-  for (const auto& c :
-       massspring::benchmark_cases(brain_vertices, brain_triangles, !options.flag("no-10x"))) {
+  for (const auto& c : chosen_cases(
+           options,
+           massspring::benchmark_cases(brain_vertices, brain_triangles, !options.flag("no-10x")))) {
     const auto result = massspring::run_benchmark_case(c, bench_options);
     const double at_working_set =
         massspring::triad_bandwidth_at(result.explicit_bytes_per_step, result.threads);
@@ -162,11 +213,11 @@ int bench_massspring(const Options& options) {
 
 int bench_command(const Arguments& args) {
   const Options options(args, {"json", "float", "no-10x"},
-                        {"mesh-dir", "threads", "samples", "seconds"});
+                        {"mesh-dir", "threads", "samples", "seconds", "cases"});
   if (options.positional().size() != 1)
     throw std::invalid_argument(
         "usage: msfem bench massspring [--json] [--mesh-dir DIR] [--threads N] [--samples N] "
-        "[--seconds S] [--float] [--no-10x]");
+        "[--seconds S] [--float] [--no-10x] [--cases NAME,...]");
   const std::string& what = options.positional().front();
   if (what == "massspring") return bench_massspring(options);
   throw std::invalid_argument("bench '" + what + "': unknown (massspring)");

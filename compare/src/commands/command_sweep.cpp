@@ -9,6 +9,7 @@
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
+#include "msfem/cases/text.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
@@ -21,17 +22,9 @@
 namespace msfem::compare {
 namespace {
 
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> parts;
-  std::stringstream in(text);
-  for (std::string p; std::getline(in, p, ',');)
-    if (!p.empty()) parts.push_back(p);
-  return parts;
-}
-
 std::vector<int> integers(const std::string& option, const std::string& text) {
   std::vector<int> values;
-  for (const auto& p : split(text)) {
+  for (const auto& p : cases::split_list(text)) {
     std::size_t used = 0;
     int v = 0;
     try {
@@ -97,7 +90,7 @@ std::vector<std::optional<double>> refinement_settings(const std::optional<std::
     passes.push_back(0.0);
     return passes;
   }
-  for (const auto& edge : split(*edges))
+  for (const auto& edge : cases::split_list(*edges))
     passes.push_back(positive_number("contact-edge-lengths", edge));
   return passes;
 }
@@ -129,7 +122,7 @@ int sweep_command(const Arguments& args) {
         ": --contact-refinement refines around the tool, but loads/tool is off");
   if (const auto i = opt.value("integrators")) {
     settings.integrators.clear();
-    for (const auto& name : split(*i))
+    for (const auto& name : cases::split_list(*i))
       settings.integrators.push_back(
           cases::parse_setting<massspring::IntegratorKind>(name, "option --integrators"));
   }

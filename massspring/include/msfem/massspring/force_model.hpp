@@ -116,6 +116,21 @@ class ForceField : public ForceModel {
     virtual void add_diagonal_blocks_part(double cx, double cv,
                                           std::vector<Eigen::Matrix3d>& blocks, int part,
                                           int parts) const = 0;
+    /// Part `part` of `parts` of two products in one pass, df1 += (∂f/∂x) dx1 and
+    /// df2 += (∂f/∂x) dx2 (by default two add_product_part calls).
+    virtual void add_product_pair_part(const Eigen::VectorXd& dx1, Eigen::VectorXd& df1,
+                                       const Eigen::VectorXd& dx2, Eigen::VectorXd& df2, int part,
+                                       int parts) const {
+      add_product_part(dx1, df1, part, parts);
+      add_product_part(dx2, df2, part, parts);
+    }
+    /// Part `part` of `parts` of the field's force at the tangent's state, f += f(x, v), from
+    /// what set_part found there (a volume's gradient holds its force too). False, f untouched,
+    /// where the tangent keeps nothing that gives it: the caller asks the field
+    /// (ForceField::add_force_part).
+    virtual bool add_force_part(Eigen::VectorXd& /*f*/, int /*part*/, int /*parts*/) const {
+      return false;
+    }
   };
   /// A tangent at the state in x and v, which must outlive it. By default it multiplies with
   /// add_dfdx_product_part at each product, which suits a field whose product costs little beside

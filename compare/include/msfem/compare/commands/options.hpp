@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "msfem/cases/text.hpp"
 #include "msfem/compare/commands/commands.hpp"
 
 namespace msfem::compare {
@@ -84,6 +85,12 @@ class Options {
   std::vector<std::string> values(const std::string& key) const {
     const auto it = values_.find(key);
     return it == values_.end() ? std::vector<std::string>{} : it->second;
+  }
+
+  /// The comma-separated entries of --key (none when it is not given).
+  std::vector<std::string> list(const std::string& key) const {
+    const auto v = value(key);
+    return v ? cases::split_list(*v) : std::vector<std::string>{};
   }
 
   /// Integer value of --key, or `fallback`; an unparsable or out-of-range value names the option.

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ struct BenchmarkCase {
   /// Volume preservation on the shell prisms between the tiers (κ = λ(E, 0.45) − λ(E, 1/4), the
   /// harness's analytic start), those inverted or flat at rest left out.
   bool volume_preservation = false;
+  /// A model built elsewhere (by a case's own pipeline, e.g. tet_edges on the FEM's mesh, which
+  /// needs a mesher massspring does not have): stepped as it is, `network` and
+  /// `volume_preservation` only describing it.
+  std::shared_ptr<const MassSpringModel> model = nullptr;
 };
 
 /// The three cases of `msfem bench massspring`:
