@@ -80,11 +80,7 @@ State NaiveAosStepper::state() const {
   return out;
 }
 
-namespace {
-
-// Steps per second over the samples; `advance(n)` runs n steps.
-template <class Advance>
-RateSpread rate_spread(Advance advance, int steps_per_call,
+RateSpread rate_spread(const std::function<void(int)>& advance, int steps_per_call,
                        const SteppingBenchmarkOptions& options) {
   using clock = std::chrono::steady_clock;
   // Warm-up: caches, page faults, thread start.
@@ -104,14 +100,12 @@ RateSpread rate_spread(Advance advance, int steps_per_call,
       advance(steps_per_call);
       steps += steps_per_call;
       elapsed = std::chrono::duration<double>(clock::now() - start).count();
-    } while (elapsed < options.seconds_per_sample);
+    } while (elapsed < options.seconds_per_sample || steps < options.min_steps_per_sample);
     rates.push_back(static_cast<double>(steps) / elapsed);
   }
   std::sort(rates.begin(), rates.end());
   return {rates.front(), rates[rates.size() / 2], rates.back()};
 }
-
-}  // namespace
 
 State perturbed_start(const MassSpringModel& model) {
   State start = initial_state(model);

@@ -92,8 +92,8 @@ void SurfaceContactForceField::set_pressure_penalty(double pressure_penalty) {
 }
 
 template <class Visit>
-void SurfaceContactForceField::for_each_contact_point(const Eigen::VectorXd& x,
-                                                      Visit&& visit) const {
+void SurfaceContactForceField::for_each_contact_point(const Eigen::VectorXd& x, Visit&& visit,
+                                                      int part, int parts) const {
   // Triangles whose rest centroid could have moved to within reach of the tool.
   double moved = 0.0;
   for (int i : nodes_)
@@ -101,7 +101,8 @@ void SurfaceContactForceField::for_each_contact_point(const Eigen::VectorXd& x,
   const double r = tool_.radius;
   const std::vector<int> near =
       broad_phase_->triangles_near(tool_.center, r + largest_triangle_radius_ + moved);
-  for (int t : near) {
+  for (std::size_t k = std::size_t(part); k < near.size(); k += std::size_t(parts)) {
+    const int t = near[k];
     const Eigen::Vector3d xa = x.segment<3>(3 * triangles_(t, 0));
     const Eigen::Vector3d xb = x.segment<3>(3 * triangles_(t, 1));
     const Eigen::Vector3d xc = x.segment<3>(3 * triangles_(t, 2));
@@ -127,16 +128,23 @@ void SurfaceContactForceField::for_each_contact_point(const Eigen::VectorXd& x,
   }
 }
 
-void SurfaceContactForceField::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd&,
+void SurfaceContactForceField::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                          Eigen::VectorXd& f) const {
+  add_force_part(x, v, f, 0, 1);
+}
+
+void SurfaceContactForceField::add_force_part(const Eigen::VectorXd& x, const Eigen::VectorXd&,
+                                              Eigen::VectorXd& f, int part, int parts) const {
   for_each_contact_point(
-      x, [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
+      x,
+      [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
         const double rho = w.norm();
         const Eigen::Vector3d push = coefficient * (tool_.radius - rho) / rho * w;
         const double b[3] = {b0, b1, b2};
         for (int k = 0; k < 3; ++k)
           f.segment<3>(3 * triangles_(t, k)) += b[k] * push;
-      });
+      },
+      part, parts);
 }
 
 double SurfaceContactForceField::potential_energy(const Eigen::VectorXd& x) const {
@@ -162,11 +170,20 @@ Eigen::Matrix3d SurfaceContactForceField::block(const Eigen::Vector3d& w,
   return result;
 }
 
-void SurfaceContactForceField::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd&,
+void SurfaceContactForceField::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                                 const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                                                 Linearisation mode) const {
+  add_dfdx_product_part(x, v, dx, df, mode, 0, 1);
+}
+
+void SurfaceContactForceField::add_dfdx_product_part(const Eigen::VectorXd& x,
+                                                     const Eigen::VectorXd&,
+                                                     const Eigen::VectorXd& dx, Eigen::VectorXd& df,
+                                                     Linearisation mode, int part,
+                                                     int parts) const {
   for_each_contact_point(
-      x, [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
+      x,
+      [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
         const double b[3] = {b0, b1, b2};
         Eigen::Vector3d moved = Eigen::Vector3d::Zero();
         for (int l = 0; l < 3; ++l)
@@ -174,7 +191,83 @@ void SurfaceContactForceField::add_dfdx_product(const Eigen::VectorXd& x, const 
         const Eigen::Vector3d change = coefficient * (block(w, mode) * moved);
         for (int k = 0; k < 3; ++k)
           df.segment<3>(3 * triangles_(t, k)) += b[k] * change;
-      });
+      },
+      part, parts);
+}
+
+// The contact points inside the tool at set_part, per part: a product gathers and scatters over
+// them alone. Parts are set and read by one thread each, so each keeps its own list.
+class KeptContactTangent final : public ForceField::Tangent {
+ public:
+  KeptContactTangent(const SurfaceContactForceField& field, const Eigen::VectorXd& x,
+                     Linearisation mode)
+      : field_(&field), x_(&x), mode_(mode), points_(kMaxParts) {}
+
+  void set_part(int part, int parts) override {
+    if (parts > kMaxParts)
+      throw ModelError("surface contact tangent: at most " + std::to_string(kMaxParts) + " parts");
+    std::vector<Point>& points = points_[std::size_t(part)];
+    points.clear();
+    field_->for_each_contact_point(
+        *x_,
+        [&](int t, double b0, double b1, double b2, double coefficient, const Eigen::Vector3d& w) {
+          const double rho = w.norm();
+          Point p;
+          for (int k = 0; k < 3; ++k)
+            p.offset[k] = 3 * field_->triangles_(t, k);
+          p.b = Eigen::Vector3d(b0, b1, b2);
+          p.push = coefficient * (field_->tool_.radius - rho) / rho * w;
+          p.stiffness = coefficient * field_->block(w, mode_);
+          points.push_back(p);
+        },
+        part, parts);
+  }
+
+  void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
+                        int) const override {
+    for (const Point& p : points_[std::size_t(part)]) {
+      Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+      for (int l = 0; l < 3; ++l)
+        moved += p.b[l] * dx.segment<3>(p.offset[l]);
+      const Eigen::Vector3d change = p.stiffness * moved;
+      for (int k = 0; k < 3; ++k)
+        df.segment<3>(p.offset[k]) += p.b[k] * change;
+    }
+  }
+
+  // Frictionless: no velocity term, cv does not enter.
+  void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
+                                int) const override {
+    for (const Point& p : points_[std::size_t(part)])
+      for (int k = 0; k < 3; ++k)
+        blocks[std::size_t(p.offset[k] / 3)] += (cx * p.b[k] * p.b[k]) * p.stiffness;
+  }
+
+  bool add_force_part(Eigen::VectorXd& f, int part, int) const override {
+    for (const Point& p : points_[std::size_t(part)])
+      for (int k = 0; k < 3; ++k)
+        f.segment<3>(p.offset[k]) += p.b[k] * p.push;
+    return true;
+  }
+
+ private:
+  static constexpr int kMaxParts = 64;  // the fast steppers' most threads
+  struct Point {
+    int offset[3];              // 3 × the triangle's nodes
+    Eigen::Vector3d b;          // barycentric weights
+    Eigen::Vector3d push;       // the point's force on the surface
+    Eigen::Matrix3d stiffness;  // coefficient × ∂(push)/∂x(s)
+  };
+  const SurfaceContactForceField* field_;
+  const Eigen::VectorXd* x_;
+  Linearisation mode_;
+  std::vector<std::vector<Point>> points_;  // per part
+};
+
+std::unique_ptr<ForceField::Tangent> SurfaceContactForceField::tangent(const Eigen::VectorXd& x,
+                                                                       const Eigen::VectorXd&,
+                                                                       Linearisation mode) const {
+  return std::make_unique<KeptContactTangent>(*this, x, mode);
 }
 
 void SurfaceContactForceField::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd&,

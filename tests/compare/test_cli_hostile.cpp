@@ -154,6 +154,9 @@ const Hostile hostile[] = {
      "option --resolutions is given twice"},
     {"BenchOnAHundredThousandThreads", "bench massspring --threads 100000",
      "option --threads 100000 is outside [1, 256]"},
+    {"BenchOfACaseItDoesNotHave", "bench massspring --cases seed_sphere,brain",
+     "option --cases: no bench case 'brain' (seed_sphere, brain_scale"},
+    {"BenchOfNoCase", "bench massspring --cases ''", "option --cases: '' lists no case"},
     {"SimplifySmoothedAMillionTimes",
      "simplify " + cases_dir +
          "/data/pancreas_vh_female_m.obj {dir}/p.obj --vertices 446 "

@@ -23,48 +23,77 @@ namespace {
 
 constexpr const char* kBrainFile = "brain_icbm152_lh_9177_mm.obj";
 
-// The one spring model whose error falls with resolution: tet_edges with volume preservation, on
-// the seed sphere's mesh exactly as `msfem sweep cases/sphere_indent_bonded.prm
-// --volume-preservation on` builds and times it (its FEM mesh, supports and bonded tool at depth),
-// so that the two commands' figures are of one model.
-massspring::BenchmarkCase accurate_sphere_case() {
-  const std::filesystem::path file =
-      std::filesystem::path(MSFEM_DEFAULT_CASES_DIR) / "sphere_indent_bonded.prm";
-  const cases::CaseParameters parameters = cases::read_case(
-      file, {"mass spring/variants=tet_edges", "mass spring/volume preservation=true"});
+// A variant of a shipped case exactly as `msfem sweep` builds and times it at the case's
+// resolution: its FEM mesh (tet_edges), supports, group scales and tool at depth (a bonded patch,
+// or the frictionless contact field), so that the two commands' figures are of one model.
+massspring::BenchmarkCase case_variant(const std::string& name, const std::string& case_file,
+                                       cases::Variant variant,
+                                       const std::vector<std::string>& settings) {
+  const std::filesystem::path file = std::filesystem::path(MSFEM_DEFAULT_CASES_DIR) / case_file;
+  const cases::CaseParameters parameters = cases::read_case(file, settings);
   const Problem problem = make_problem(parameters);
-  const fem_reference::VolumeMesh mesh = mesh_problem(problem);
-  BuiltVariant built =
-      build_variant(cases::Variant::tet_edges, problem, mesh,
-                    problem.tools.empty() ? std::nullopt : std::optional(problem.tools.front()));
+  fem_reference::VolumeMesh mesh;
+  if (variant == cases::Variant::tet_edges) mesh = mesh_problem(problem);
+  std::optional<ToolPlacement> tool;
+  if (!problem.tools.empty()) tool = problem.tools.front();
+  BuiltVariant built = build_variant(variant, problem, mesh, tool);
   massspring::BenchmarkCase c;
-  c.name = "seed_sphere_tet_edges_volume";
-  c.description = "tet_edges with volume preservation on the seed sphere's FEM mesh (" +
-                  file.filename().string() + ", its bonded tool at depth)";
+  c.name = name;
+  c.description = built.name + " of " + case_file + " as msfem sweep times it";
+  for (const std::string& setting : settings)
+    c.description += ", " + setting;
   c.network = built.model->network();
-  c.volume_preservation = true;
+  c.volume_preservation = parameters.mass_spring.volume_preservation;
   c.model = std::move(built.model);
   return c;
 }
 
-// The cases the command runs: every one, or those --cases names (unknown names refused).
-std::vector<massspring::BenchmarkCase> chosen_cases(const Options& options,
-                                                    std::vector<massspring::BenchmarkCase> all) {
-  all.push_back(accurate_sphere_case());
+const std::vector<std::string> kBuiltinCases = {"seed_sphere", "brain_scale", "brain_scale_volume",
+                                                "brain_10x"};
+const std::vector<std::string> kCaseFileCases = {"seed_sphere_contact",
+                                                 "seed_sphere_tet_edges_volume"};
+
+// The names --cases gives (all when it is not given), checked before anything is built.
+std::vector<std::string> wanted_cases(const Options& options) {
+  std::vector<std::string> known = kBuiltinCases;
+  if (options.flag("no-10x")) known.pop_back();
+  known.insert(known.end(), kCaseFileCases.begin(), kCaseFileCases.end());
+  if (!options.value("cases")) return known;
   const std::vector<std::string> wanted = options.list("cases");
-  if (wanted.empty()) return all;
-  std::vector<massspring::BenchmarkCase> chosen;
-  for (const std::string& name : wanted) {
-    auto it = std::find_if(all.begin(), all.end(), [&](const auto& c) { return c.name == name; });
-    if (it == all.end()) {
-      std::string known;
-      for (const auto& c : all)
-        known += (known.empty() ? "" : ", ") + c.name;
-      throw cases::InputError("--cases: no bench case '" + name + "' (" + known + ")");
+  if (wanted.empty()) throw std::invalid_argument("option --cases: '' lists no case");
+  for (const std::string& name : wanted)
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::string list;
+      for (const auto& k : known)
+        list += (list.empty() ? "" : ", ") + k;
+      throw std::invalid_argument("option --cases: no bench case '" + name + "' (" + list + ")");
     }
-    chosen.push_back(std::move(*it));
-    all.erase(it);
-  }
+  return wanted;
+}
+
+// The wanted cases, built in the order named: the massspring-only models, then the shipped case
+// files' (the seed sphere pressed by the frictionless tool, the default case's model; tet_edges
+// with volume preservation, the one spring model whose error falls with resolution).
+std::vector<massspring::BenchmarkCase> built_cases(
+    const std::vector<std::string>& wanted, const std::optional<Eigen::MatrixX3d>& brain_vertices,
+    const std::optional<Eigen::MatrixX3i>& brain_triangles) {
+  const auto named = [&](const std::string& name) {
+    return std::find(wanted.begin(), wanted.end(), name) != wanted.end();
+  };
+  std::vector<massspring::BenchmarkCase> all;
+  if (std::any_of(kBuiltinCases.begin(), kBuiltinCases.end(), named))
+    all = massspring::benchmark_cases(brain_vertices, brain_triangles, named("brain_10x"));
+  if (named("seed_sphere_contact"))
+    all.push_back(
+        case_variant("seed_sphere_contact", "sphere_indent.prm", cases::Variant::three_tier, {}));
+  if (named("seed_sphere_tet_edges_volume"))
+    all.push_back(case_variant("seed_sphere_tet_edges_volume", "sphere_indent_bonded.prm",
+                               cases::Variant::tet_edges,
+                               {"mass spring/volume preservation=true"}));
+  std::vector<massspring::BenchmarkCase> chosen;
+  for (const std::string& name : wanted)
+    for (auto& c : all)
+      if (c.name == name) chosen.push_back(std::move(c));
   return chosen;
 }
 
@@ -131,6 +160,7 @@ int bench_massspring(const Options& options) {
       options.value("mesh-dir").value_or(std::string(MSFEM_DEFAULT_CASES_DIR) + "/data");
   const std::filesystem::path brain_path = mesh_dir / kBrainFile;
 
+  const std::vector<std::string> wanted = wanted_cases(options);
   std::optional<Eigen::MatrixX3d> brain_vertices;
   std::optional<Eigen::MatrixX3i> brain_triangles;
   if (std::filesystem::exists(brain_path)) {
@@ -163,9 +193,7 @@ int bench_massspring(const Options& options) {
     if (!json) std::printf("triad at %7.2f MB: %7.2f GB/s\n", megabytes, 1e-9 * rate);
   }
   nlohmann::json cases_json = nlohmann::json::array();
-  for (const auto& c : chosen_cases(
-           options,
-           massspring::benchmark_cases(brain_vertices, brain_triangles, !options.flag("no-10x")))) {
+  for (const auto& c : built_cases(wanted, brain_vertices, brain_triangles)) {
     const auto result = massspring::run_benchmark_case(c, bench_options);
     const double at_working_set =
         massspring::triad_bandwidth_at(result.explicit_bytes_per_step, result.threads);

@@ -13,6 +13,7 @@
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/stability.hpp"
+#include "msfem/massspring_bench/stepping_benchmark.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -32,19 +33,16 @@ void stable_step(Timing& t, const ms::MassSpringModel& model, ms::IntegratorKind
   }
 }
 
-// Steps per second: the median of five batches after a warm-up.
+// Steps per second as msfem bench takes them (massspring::rate_spread: the median of five samples
+// after a warm-up, explicit steps ten per call), samples of a tenth of a second and at least a
+// fifth of the case's timing/steps each.
 double median_rate(VariantStepper& stepper, double dt, int steps) {
-  const int batches = 5;
-  const int per_batch = std::max(1, steps / batches);
-  stepper.advance(dt, std::max(1, per_batch / 4));
-  std::vector<double> rates;
-  for (int b = 0; b < batches; ++b) {
-    const auto batch_start = Clock::now();
-    stepper.advance(dt, per_batch);
-    rates.push_back(per_batch / std::max(seconds_since(batch_start), 1e-9));
-  }
-  std::sort(rates.begin(), rates.end());
-  return rates[rates.size() / 2];
+  ms::SteppingBenchmarkOptions options;
+  options.seconds_per_sample = 0.1;
+  options.min_steps_per_sample = std::max(1, steps / options.samples);
+  return ms::rate_spread([&](int n) { stepper.advance(dt, n); },
+                         stepper.explicit_steps() ? options.steps_per_call : 1, options)
+      .median;
 }
 
 // Wall time from rest, with the load applied, to within 1 % of the static equilibrium's travel.
@@ -104,6 +102,10 @@ ms::State VariantStepper::state() const {
 void VariantStepper::update_parameters(const ms::MassSpringModel& model) {
   if (explicit_) return explicit_->update_parameters(model);
   implicit_->update_parameters(model);
+}
+
+bool VariantStepper::explicit_steps() const {
+  return explicit_ != nullptr;
 }
 
 const char* VariantStepper::name() const {

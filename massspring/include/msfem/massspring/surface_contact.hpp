@@ -35,6 +35,16 @@ class SurfaceContactForceField : public ToolContact {
                         Linearisation mode = Linearisation::exact) const override;
   void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
                          Linearisation mode = Linearisation::exact) const override;
+  /// Parts take every parts-th triangle the broad phase finds near the tool.
+  void add_force_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f,
+                      int part, int parts) const override;
+  void add_dfdx_product_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                             const Eigen::VectorXd& dx, Eigen::VectorXd& df, Linearisation mode,
+                             int part, int parts) const override;
+  /// The contact points found once per set_part, each with its force and stiffness block: a
+  /// product is a pass over the points inside the tool, not a new search of the sub-triangles.
+  std::unique_ptr<Tangent> tangent(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                   Linearisation mode) const override;
 
   const SphereTool& tool() const override { return tool_; }
   const std::vector<int>& nodes() const override { return nodes_; }
@@ -53,10 +63,13 @@ class SurfaceContactForceField : public ToolContact {
   struct BroadPhase;  ///< the k-d tree (defined in the source)
 
  private:
+  friend class KeptContactTangent;
   /// Calls `visit(triangle, b0, b1, b2, coefficient, w)` for every quadrature point inside the
-  /// sphere, coefficient = κ A weight, w = x(s) - c.
+  /// sphere, coefficient = κ A weight, w = x(s) - c, on part `part` of `parts` of the triangles
+  /// near the tool (every parts-th, so that the touched ones spread over the parts).
   template <class Visit>
-  void for_each_contact_point(const Eigen::VectorXd& x, Visit&& visit) const;
+  void for_each_contact_point(const Eigen::VectorXd& x, Visit&& visit, int part = 0,
+                              int parts = 1) const;
   Eigen::Matrix3d block(const Eigen::Vector3d& w, Linearisation mode) const;
 
   int num_nodes_;

@@ -34,6 +34,8 @@ class VariantStepper {
   void update_parameters(const massspring::MassSpringModel& model);
   /// fast_explicit or fast_implicit.
   const char* name() const;
+  /// True on the fast explicit stepper, which takes many steps per call at one thread start.
+  bool explicit_steps() const;
 
  private:
   std::unique_ptr<massspring::FastExplicitStepper> explicit_;

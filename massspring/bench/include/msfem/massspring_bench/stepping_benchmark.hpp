@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,7 @@ struct SteppingBenchmarkOptions {
   bool single_precision = false;    ///< float for the explicit and the implicit fast stepper
   int steps_per_call = 10;          ///< explicit steps per FastExplicitStepper::step call
   double seconds_per_sample = 0.2;  ///< each sample runs at least this long
+  long min_steps_per_sample = 0;    ///< and at least this many steps
   int samples = 5;                  ///< the median is reported
   bool run_naive = true;
   bool run_implicit = true;
@@ -92,7 +94,13 @@ struct SteppingBenchmarkResult {
 /// Measures steps per second of the explicit fast stepper, the naive loop and the implicit fast
 /// stepper on the model (loads and supports as set in it), in this process, after a warm-up. All
 /// three start from the rest state with every free node displaced by a fixed pseudo-random 10⁻³ of
-/// the mean spring length, so that every spring is loaded and the run stays bounded.
+/// Steps per second of `advance(n)` (n steps, n = steps_per_call) after a warm-up of a quarter
+/// sample: min, median and max over options.samples samples of options.seconds_per_sample (and
+/// options.min_steps_per_sample) each. The one timing loop of msfem bench and of the harness's
+/// timing (msfem run, sweep), so that their figures are taken alike.
+RateSpread rate_spread(const std::function<void(int)>& advance, int steps_per_call,
+                       const SteppingBenchmarkOptions& options);
+
 /// Rest state with every node moved by a fixed pseudo-random 10⁻³ of the mean spring length: all
 /// springs loaded, the motion bounded. Every speed measurement starts from it.
 State perturbed_start(const MassSpringModel& model);
