@@ -234,7 +234,9 @@ void declare_fem_timing_output(ParameterHandler& prm) {
                     "Integrator whose steps are timed.");
   prm.declare_entry("dt", "0", Patterns::Double(0),
                     "Time step (s); 0: half the estimated stable step of each variant.");
-  prm.declare_entry("steps", "2000", Patterns::Integer(1, 100000000), "Dynamic steps timed.");
+  prm.declare_entry(
+      "steps", "2000", Patterns::Integer(1, 100000000),
+      "Dynamic steps timed, at least (five samples of a fifth of them and of 0.1 s each).");
   prm.leave_subsection();
   prm.enter_subsection("output");
   prm.declare_entry("directory", default_output_directory, Patterns::Anything(),

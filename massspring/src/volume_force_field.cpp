@@ -47,8 +47,8 @@ void add_element_product_pair(const Vec3* g, const int* offset, int nodes, doubl
   }
 }
 
-// ... and its diagonal blocks, times cx: blocks[i] −= cx scale/36 g_i g_iᵀ, written out as the
-// symmetric outer product it is (Eigen's g gᵀ expression took 4x as long on the seed's tets).
+// ... and its diagonal blocks, times cx: blocks[i] −= cx scale/36 g_i g_iᵀ, the symmetric outer
+// product written out.
 void add_element_blocks(const Vec3* g, const int* offset, int nodes, double cx, double scale,
                         std::vector<Mat3>& blocks) {
   const double c = cx * scale / 36.0;
