@@ -157,6 +157,8 @@ const Hostile hostile[] = {
     {"BenchOfACaseItDoesNotHave", "bench massspring --cases seed_sphere,brain",
      "option --cases: no bench case 'brain' (seed_sphere, brain_scale"},
     {"BenchOfNoCase", "bench massspring --cases ''", "option --cases: '' lists no case"},
+    {"BenchOfACaseNamedTwice", "bench massspring --cases seed_sphere,seed_sphere",
+     "option --cases: 'seed_sphere' is named twice"},
     {"SimplifySmoothedAMillionTimes",
      "simplify " + cases_dir +
          "/data/pancreas_vh_female_m.obj {dir}/p.obj --vertices 446 "
