@@ -205,8 +205,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     fields_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_.num_nodes), 0);
     for (const auto& field : model.fields()) {
-      fields_.push_back(field.field);
-      for (int node : field.field->nodes())
+      fields_.push_back(field);
+      for (int node : field->nodes())
         used[static_cast<std::size_t>(node)] = 1;
     }
     field_nodes_.clear();

@@ -1,11 +1,20 @@
 #include "msfem/massspring/force_model.hpp"
 
+#include <algorithm>
+
 #include "msfem/massspring/errors.hpp"
 
 namespace msfem::massspring {
 
 std::shared_ptr<const ForceField> ForceField::scaled(const std::string& group, double) const {
-  throw ModelError("force field: no coefficient group '" + group + "' to scale");
+  throw ModelError(name() + ": no coefficient group '" + group + "' to scale");
+}
+
+std::vector<double> ForceField::coefficients(const std::string& group) const {
+  const std::vector<std::string> groups = coefficient_groups();
+  if (std::find(groups.begin(), groups.end(), group) == groups.end())
+    throw ModelError(name() + ": no coefficient group '" + group + "'");
+  return {1.0};
 }
 
 namespace {

@@ -3,6 +3,7 @@
 // ∂f/∂x is the definite linearisation, so the matrix is SPD and CG applies (matrix-free).
 
 #include <cmath>
+#include <vector>
 
 #include "msfem/massspring/integrators.hpp"
 
@@ -10,8 +11,9 @@ namespace msfem::massspring {
 namespace {
 
 // Diagonal of the system for Jacobi preconditioning: m_i + h (c_i + Σ d_s) + h² Σ k_s over the
-// springs at node i (the exact diagonal up to the n nᵀ direction factors, which are <= 1).
-Eigen::VectorXd jacobi_diagonal(const MassSpringModel& model, double h) {
+// springs at node i (the exact diagonal up to the n nᵀ direction factors, which are <= 1), and
+// the diagonal of each field's own blocks of -h ∂f/∂v - h² ∂f/∂x.
+Eigen::VectorXd jacobi_diagonal(const MassSpringModel& model, const State& state, double h) {
   const SpringNetwork& net = model.network();
   Eigen::VectorXd per_node = net.masses + h * net.node_damping;
   for (int s = 0; s < net.num_springs(); ++s) {
@@ -21,12 +23,15 @@ Eigen::VectorXd jacobi_diagonal(const MassSpringModel& model, double h) {
   }
   for (int a = 0; a < net.num_anchors(); ++a)
     per_node[net.anchor_node[a]] += h * net.anchor_damping[a] + h * h * net.anchor_stiffness[a];
-  if (model.contact())
-    for (int i : model.contact()->nodes())
-      per_node[i] += h * h * model.contact()->penalty_stiffness();
   Eigen::VectorXd diagonal(3 * net.num_nodes());
   for (int i = 0; i < net.num_nodes(); ++i)
     diagonal.segment<3>(3 * i).setConstant(per_node[i]);
+  if (model.fields().empty()) return diagonal;
+  std::vector<Eigen::Matrix3d> blocks(net.num_nodes(), Eigen::Matrix3d::Zero());
+  for (const auto& field : model.fields())
+    field->add_diagonal_blocks(state.x, state.v, -h * h, -h, blocks, Linearisation::definite);
+  for (int i = 0; i < net.num_nodes(); ++i)
+    diagonal.segment<3>(3 * i) += blocks[i].diagonal();
   return diagonal;
 }
 
@@ -53,7 +58,7 @@ void Integrator::implicit_euler_step(const MassSpringModel& model, State& state,
   Eigen::VectorXd b = h * (model.force(x, v) + h * kv);
   model.zero_constrained(b);
 
-  const Eigen::VectorXd inverse_diagonal = jacobi_diagonal(model, h).cwiseInverse();
+  const Eigen::VectorXd inverse_diagonal = jacobi_diagonal(model, state, h).cwiseInverse();
   Eigen::VectorXd dv =
       previous_dv_.size() == n ? previous_dv_ : Eigen::VectorXd(Eigen::VectorXd::Zero(n));
   model.zero_constrained(dv);

@@ -32,9 +32,9 @@ class ImplicitFields {
     tangents_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
     for (const auto& field : model.fields()) {
-      fields_.push_back(field.field);
-      tangents_.push_back(field.field->tangent(x_, v_, Linearisation::definite));
-      for (int node : field.field->nodes())
+      fields_.push_back(field);
+      tangents_.push_back(field->tangent(x_, v_, Linearisation::definite));
+      for (int node : field->nodes())
         used[static_cast<std::size_t>(node)] = 1;
     }
     std::vector<int> lane_of(static_cast<std::size_t>(soa_->num_nodes), -1);

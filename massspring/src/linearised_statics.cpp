@@ -15,14 +15,20 @@ LinearisedStatics::LinearisedStatics(
   const int n = model.num_dofs();
   const Eigen::VectorXd rest = model.rest_state();
   const std::size_t fields = model.fields().size();
+  field_rest_force_.resize(parts.size() + fields);
   for (std::size_t p = 0; p < parts.size() + fields; ++p) {
     MassSpringModel part = model;
     const bool field_part = p >= parts.size();
+    if (field_part) {
+      Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+      model.fields()[p - parts.size()]->add_force(rest, Eigen::VectorXd::Zero(n), f);
+      if (!f.isZero(0.0)) field_rest_force_[p] = f;
+    }
     part.set_stiffness(field_part ? Eigen::VectorXd::Zero(model.network().num_springs())
                                   : parts[p]);
     if (p > 0 && part.network().num_anchors() > 0) part.set_anchor_parameters(0.0, 0.0);
-    for (const auto& f : model.fields())
-      if (!field_part || f.name != model.fields()[p - parts.size()].name) part.clear_field(f.name);
+    part.clear_fields<ForceField>();
+    if (field_part) part.add_field(model.fields()[p - parts.size()]);
     Triplets t;
     part.add_dfdx_triplets(rest, Eigen::VectorXd::Zero(n), t, Linearisation::exact);
     Eigen::SparseMatrix<double> j(n, n);
@@ -60,6 +66,9 @@ LinearisedStatics::Solution LinearisedStatics::solve(const std::vector<double>& 
   for (std::size_t p = 1; p < jacobians_.size(); ++p) {
     k += weights[p] * free_stiffness_[p];
     rhs += weights[p] * free_load_[p];
+    // rest_force_ holds each field's rest force at weight 1.
+    if (field_rest_force_[p].size() > 0)
+      rhs += (weights[p] - 1.0) * (select_ * field_rest_force_[p]);
   }
   if (!cholesky_->factorize(k))
     throw std::runtime_error(
@@ -85,8 +94,11 @@ LinearisedStatics::Solution LinearisedStatics::solve(const std::vector<double>& 
   for (int node : patch)
     for (int c = 0; c < 3; ++c) {
       double f = rest_force_[3 * node + c];
-      for (std::size_t p = 0; p < jacobians_.size(); ++p)
+      for (std::size_t p = 0; p < jacobians_.size(); ++p) {
         f += weights[p] * jacobians_[p].col(3 * node + c).dot(u);
+        if (field_rest_force_[p].size() > 0)
+          f += (weights[p] - 1.0) * field_rest_force_[p][3 * node + c];
+      }
       s.patch_force[c] += f;
     }
   return s;

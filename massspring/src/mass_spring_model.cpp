@@ -152,57 +152,47 @@ Eigen::Vector3d MassSpringModel::constrained_target(int node) const {
   return (network_.rest_positions.row(node) + prescribed_displacement_.row(node)).transpose();
 }
 
-void MassSpringModel::set_field(const std::string& name, std::shared_ptr<const ForceField> field) {
-  if (!field) throw ModelError("force field '" + name + "': none given");
-  if (field->num_dofs() != num_dofs())
-    throw ModelError("force field '" + name + "': built for " +
-                     std::to_string(field->num_dofs() / 3) + " nodes, model has " +
-                     std::to_string(num_nodes()));
-  for (auto& f : fields_)
-    if (f.name == name) {
-      f.field = std::move(field);
-      return;
-    }
-  fields_.push_back({name, std::move(field)});
+namespace {
+
+void check_field(const ForceField* field, int num_nodes) {
+  if (!field) throw ModelError("force field: none given");
+  if (field->num_dofs() != 3 * num_nodes)
+    throw ModelError(field->name() + ": built for " + std::to_string(field->num_dofs() / 3) +
+                     " nodes, model has " + std::to_string(num_nodes));
 }
 
-void MassSpringModel::clear_field(const std::string& name) {
-  fields_.erase(std::remove_if(fields_.begin(), fields_.end(),
-                               [&](const NamedField& f) { return f.name == name; }),
-                fields_.end());
+}  // namespace
+
+void MassSpringModel::add_field(std::shared_ptr<const ForceField> field) {
+  check_field(field.get(), num_nodes());
+  fields_.push_back(std::move(field));
 }
 
-const ForceField* MassSpringModel::field(const std::string& name) const {
-  for (const auto& f : fields_)
-    if (f.name == name) return f.field.get();
-  return nullptr;
+void MassSpringModel::replace_field(std::size_t index, std::shared_ptr<const ForceField> field) {
+  if (index >= fields_.size())
+    throw ModelError("force field " + std::to_string(index) + ": the model has " +
+                     std::to_string(fields_.size()));
+  check_field(field.get(), num_nodes());
+  fields_[index] = std::move(field);
 }
 
 std::string MassSpringModel::field_names() const {
   std::string names;
   for (const auto& f : fields_)
-    names += (names.empty() ? "" : ", ") + f.name;
+    names += (names.empty() ? "" : ", ") + f->name();
   return names;
 }
 
 void MassSpringModel::set_contact(const SphereContactForceField& contact) {
-  set_field(contact_field, std::make_shared<const SphereContactForceField>(contact));
+  set_field<ToolContact>(std::make_shared<const SphereContactForceField>(contact));
 }
 
 void MassSpringModel::set_contact(const SurfaceContactForceField& contact) {
-  set_field(contact_field, std::make_shared<const SurfaceContactForceField>(contact));
-}
-
-const ToolContact* MassSpringModel::contact() const {
-  return dynamic_cast<const ToolContact*>(field(contact_field));
+  set_field<ToolContact>(std::make_shared<const SurfaceContactForceField>(contact));
 }
 
 void MassSpringModel::set_volume(const VolumeForceField& volume) {
-  set_field(volume_field, std::make_shared<const VolumeForceField>(volume));
-}
-
-const VolumeForceField* MassSpringModel::volume() const {
-  return dynamic_cast<const VolumeForceField*>(field(volume_field));
+  set_field<VolumeForceField>(std::make_shared<const VolumeForceField>(volume));
 }
 
 void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
@@ -211,7 +201,7 @@ void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd&
   for (int i = 0; i < num_nodes(); ++i)
     f.segment<3>(3 * i) += network_.masses[i] * gravity_ + external_force_.row(i).transpose();
   for (const auto& field : fields_)
-    field.field->add_force(x, v, f);
+    field->add_force(x, v, f);
 }
 
 double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
@@ -221,7 +211,7 @@ double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
     energy -= (network_.masses[i] * gravity_ + external_force_.row(i).transpose())
                   .dot(x.segment<3>(3 * i));
   for (const auto& field : fields_)
-    energy += field.field->potential_energy(x);
+    energy += field->potential_energy(x);
   return energy;
 }
 
@@ -230,27 +220,27 @@ void MassSpringModel::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::Ve
                                        Linearisation mode) const {
   springs().add_dfdx_product(x, v, dx, df, mode);
   for (const auto& field : fields_)
-    field.field->add_dfdx_product(x, v, dx, df, mode);
+    field->add_dfdx_product(x, v, dx, df, mode);
 }
 
 void MassSpringModel::add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
                                        Eigen::VectorXd& df) const {
   springs().add_dfdv_product(x, dv, df);
   for (const auto& field : fields_)
-    field.field->add_dfdv_product(x, dv, df);
+    field->add_dfdv_product(x, dv, df);
 }
 
 void MassSpringModel::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                         Triplets& triplets, Linearisation mode) const {
   springs().add_dfdx_triplets(x, v, triplets, mode);
   for (const auto& field : fields_)
-    field.field->add_dfdx_triplets(x, v, triplets, mode);
+    field->add_dfdx_triplets(x, v, triplets, mode);
 }
 
 void MassSpringModel::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const {
   springs().add_dfdv_triplets(x, triplets);
   for (const auto& field : fields_)
-    field.field->add_dfdv_triplets(x, triplets);
+    field->add_dfdv_triplets(x, triplets);
 }
 
 Eigen::VectorXd MassSpringModel::initial_state() const {

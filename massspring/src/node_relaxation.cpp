@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace msfem::massspring::detail {
 namespace {
@@ -34,18 +35,23 @@ NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
   bucket(
       net.num_nodes(), net.num_anchors(), 1, [&](int a, int) { return net.anchor_node[a]; },
       anchor_start_, anchors_);
-  in_contact_set_.assign(net.num_nodes(), 0);
-  // A node contact's energy is local to each node, and relaxed here with the springs'. Any other
-  // field's may couple its nodes (a volume element's couples all of it, a surface contact's
-  // triangle its three): those nodes are left to Newton.
+  // A nodewise field's energy (a node contact's) is local to each node, and relaxed here with the
+  // springs'. Any other field's may couple its nodes (a volume element's couples all of it, a
+  // surface contact's triangle its three): those nodes are left to Newton.
   left_to_newton_.assign(net.num_nodes(), 0);
-  for (const auto& f : model.fields()) {
-    const auto* nodal = dynamic_cast<const SphereContactForceField*>(f.field.get());
-    const bool relaxed_here = nodal && !nodal_contact_;  // the first node contact only
-    if (relaxed_here) nodal_contact_ = nodal;
-    for (int i : f.field->nodes())
-      (relaxed_here ? in_contact_set_ : left_to_newton_)[i] = 1;
-  }
+  std::vector<std::pair<int, const ForceField*>> terms;
+  for (const auto& field : model.fields())
+    for (int i : field->nodes())
+      if (field->nodewise())
+        terms.emplace_back(i, field.get());
+      else
+        left_to_newton_[i] = 1;
+  bucket(
+      net.num_nodes(), static_cast<int>(terms.size()), 1,
+      [&](int t, int) { return terms[t].first; }, node_term_start_, node_term_);
+  node_term_field_.resize(terms.size());
+  for (std::size_t t = 0; t < terms.size(); ++t)
+    node_term_field_[t] = terms[t].second;
 }
 
 double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vector3d& p,
@@ -78,17 +84,8 @@ double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vecto
     f -= net.anchor_stiffness[a] * d;
     k += net.anchor_stiffness[a] * identity;
   }
-  if (in_contact_set_[i]) {
-    const SphereContactForceField& contact = *nodal_contact_;
-    const Eigen::Vector3d w = p - contact.tool().center;
-    const double rho = w.norm();
-    const double gap = contact.tool().radius - rho;
-    if (gap > 0.0 && rho > 0.0) {
-      energy += 0.5 * contact.penalty_stiffness() * gap * gap;
-      f += contact.penalty_stiffness() * gap / rho * w;
-      k += contact.penalty_stiffness() * (w / rho) * (w / rho).transpose();
-    }
-  }
+  for (int q = node_term_start_[i]; q < node_term_start_[i + 1]; ++q)
+    energy += node_term_field_[node_term_[q]]->add_node_term(i, p, f, k);
   if (force) *force = f;
   if (stiffness) *stiffness = k;
   return energy;

@@ -27,18 +27,18 @@ class NodeRelaxation {
   int relax(Eigen::VectorXd& x, const Eigen::VectorXd& f, double fraction, int sweeps) const;
 
  private:
-  // Node i's share of the energy (its springs, anchors, load and tool contact) at position p,
+  // Node i's share of the energy (its springs, anchors, load and nodewise fields) at position p,
   // with the others at x; also its force and a positive semi-definite stiffness when asked.
   double local(const Eigen::VectorXd& x, int i, const Eigen::Vector3d& p, Eigen::Vector3d* force,
                Eigen::Matrix3d* stiffness) const;
   void relax_node(Eigen::VectorXd& x, int i) const;
 
   const MassSpringModel& model_;
-  std::vector<int> spring_start_, springs_;  // springs at each node (CSR)
-  std::vector<int> anchor_start_, anchors_;  // anchors at each node (CSR)
-  std::vector<char> in_contact_set_;         // node is one the node contact can touch
-  std::vector<char> left_to_newton_;         // node's energy is not local (volume, surface contact)
-  const SphereContactForceField* nodal_contact_ = nullptr;
+  std::vector<int> spring_start_, springs_;         // springs at each node (CSR)
+  std::vector<int> anchor_start_, anchors_;         // anchors at each node (CSR)
+  std::vector<int> node_term_start_, node_term_;    // nodewise fields' terms at each node (CSR)
+  std::vector<const ForceField*> node_term_field_;  // each term's field
+  std::vector<char> left_to_newton_;  // node's energy is not local (volume, surface contact)
 };
 
 }  // namespace msfem::massspring::detail

@@ -60,6 +60,18 @@ double SphereContactForceField::potential_energy(const Eigen::VectorXd& x) const
   return energy;
 }
 
+// The node's penalty term with its definite stiffness (the static relaxation's local Newton).
+double SphereContactForceField::add_node_term(int, const Eigen::Vector3d& p, Eigen::Vector3d& f,
+                                              Eigen::Matrix3d& k) const {
+  const Eigen::Vector3d w = p - tool_.center;
+  const double rho = w.norm();
+  const double gap = tool_.radius - rho;
+  if (!(gap > 0.0 && rho > 0.0)) return 0.0;
+  f += penalty_ * gap / rho * w;
+  k += penalty_ * (w / rho) * (w / rho).transpose();
+  return 0.5 * penalty_ * gap * gap;
+}
+
 Eigen::Matrix3d SphereContactForceField::block(const Eigen::Vector3d& position,
                                                Linearisation mode) const {
   const Eigen::Vector3d w = position - tool_.center;

@@ -183,6 +183,11 @@ std::shared_ptr<const ForceField> VolumeForceField::scaled(const std::string& gr
   return copy;
 }
 
+std::vector<double> VolumeForceField::coefficients(const std::string& group) const {
+  if (group != "volume") return ForceField::coefficients(group);
+  return {elements_.modulus.data(), elements_.modulus.data() + elements_.modulus.size()};
+}
+
 void VolumeForceField::set_modulus(const Eigen::VectorXd& modulus) {
   if (modulus.size() != elements_.num_elements() || !modulus.allFinite() ||
       (modulus.array() < 0.0).any())

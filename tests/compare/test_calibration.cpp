@@ -2,7 +2,11 @@
 // stands in for the FEM, and the fit, started 2-3x off, has to find the coefficients again.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+
+#include "../massspring/grasper.hpp"
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/calibration/calibration.hpp"
@@ -27,9 +31,11 @@ cases::CaseParameters sphere_case() {
   return p;
 }
 
-// "FEM" data: the three-tier model with the given group scales, solved on each tool at its depth.
-std::vector<CalibrationLoad> synthetic_references(const Problem& truth, std::vector<double> depths = {
-                                                                          0.004, 0.003, 0.0035}) {
+// "FEM" data: the three-tier model with the given group scales (and whatever `dress` adds to it),
+// solved on each tool at its depth.
+std::vector<CalibrationLoad> synthetic_references(
+    const Problem& truth, std::vector<double> depths = {0.004, 0.003, 0.0035},
+    const std::function<void(BuiltVariant&)>& dress = {}) {
   std::vector<CalibrationLoad> refs;
   const fem_reference::VolumeMesh no_mesh;
   for (std::size_t i = 0; i < truth.tools.size(); ++i) {
@@ -37,6 +43,7 @@ std::vector<CalibrationLoad> synthetic_references(const Problem& truth, std::vec
     r.load = {truth.parameters.loads.tool.directions[i], depths[i]};
     r.tool = at_depth(truth.tools[i], depths[i]);
     BuiltVariant v = build_variant(cases::Variant::three_tier, truth, no_mesh, r.tool);
+    if (dress) dress(v);
     const StaticSolution s = solve_variant_static(v);
     r.surface_displacement = s.surface_displacement;
     r.tool_force = s.tool_force;
@@ -104,6 +111,55 @@ TEST(Calibration, RecoversTheVolumeModulusWithTheSprings) {
   EXPECT_EQ(fit.groups[2].springs, 2 * make_problem(p).surface.triangles.rows());  // two shells
   const double kappa = 3000.0 * (0.45 / (1.45 * 0.1) - 0.25 / (1.25 * 0.5));
   EXPECT_NEAR(fit.groups[2].fitted_stiffness_n_per_m / (0.6 * kappa), 1.0, 0.01);
+}
+
+// A field a simulator adds to a built variant is fitted by its coefficient group as the model's
+// own are: data made with a grasper (massspring's test field, written outside it) pulling the
+// -z pole 3 mm down at k = 40 N/m, fitted from k = 16 N/m.
+TEST(Calibration, FitsTheCoefficientGroupOfAFieldWrittenOutsideMassspring) {
+  const Problem problem = make_problem(sphere_case());
+  const auto add_grasper = [](double k, double pull) {
+    return [k, pull](BuiltVariant& v) {
+      const Eigen::MatrixX3d& rest = v.model->network().rest_positions;
+      std::vector<int> surface = v.model->network().surface_nodes;
+      std::sort(surface.begin(), surface.end(),
+                [&](int a, int b) { return rest(a, 2) < rest(b, 2); });
+      const std::vector<int> held(surface.begin(), surface.begin() + 5);
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int i : held)
+        centroid += rest.row(i).transpose() / 5.0;
+      v.model->add_field(std::make_shared<massspring::testing::Grasper>(
+          v.model->num_nodes(), held, centroid - Eigen::Vector3d(0, 0, pull), k, 0.0));
+    };
+  };
+  const auto refs = synthetic_references(problem, {0.004, 0.003, 0.0035}, add_grasper(40.0, 0.003));
+  BuiltVariant base = build_variant(cases::Variant::three_tier, problem, {}, refs.front().tool);
+  add_grasper(16.0, 0.003)(base);
+  CalibrationOptions options;
+  options.groups = {"grasp"};
+  options.tolerance = 1e-7;
+  const std::vector<CalibrationLoad> train(refs.begin(), refs.begin() + 2);
+  const std::vector<CalibrationLoad> test(refs.begin() + 2, refs.end());
+  const CalibrationFit fit = calibrate(problem, base, train, test, options);
+  ASSERT_EQ(fit.groups.size(), 1u);
+  EXPECT_FALSE(fit.groups[0].spring_group);
+  EXPECT_EQ(fit.groups[0].unit, "N/m");
+  EXPECT_EQ(fit.groups[0].springs, 1);
+  EXPECT_NEAR(fit.groups[0].factor / 2.5, 1.0, 0.01);
+  EXPECT_NEAR(fit.groups[0].fitted_stiffness_n_per_m / 40.0, 1.0, 0.01);
+  EXPECT_GT(fit.before.train[0].rel_l2_error, 0.02);
+  EXPECT_LT(fit.after.test[0].rel_l2_error, 1e-3);
+  // The linearised fit weighs the field as one part, and finds the same k where the loads are
+  // small enough for the model linearised at rest.
+  const auto small = synthetic_references(problem, {5e-5, 5e-5, 5e-5}, add_grasper(40.0, 3e-5));
+  BuiltVariant small_base =
+      build_variant(cases::Variant::three_tier, problem, {}, small.front().tool);
+  add_grasper(16.0, 3e-5)(small_base);
+  options.linear = true;
+  const CalibrationFit linear =
+      calibrate(problem, small_base, {small[0], small[1]}, {small[2]}, options);
+  ASSERT_EQ(linear.groups.size(), 1u);
+  EXPECT_NEAR(linear.groups[0].fitted_stiffness_n_per_m / 40.0, 1.0, 0.01);
 }
 
 TEST(Calibration, TheVolumeGroupNeedsVolumePreservation) {

@@ -1,5 +1,6 @@
 #include "force_jacobian_check.hpp"
 
+#include <algorithm>
 #include <random>
 
 namespace msfem::massspring::testing {
@@ -57,6 +58,72 @@ JacobianErrors check_force_jacobians(const ForceModel& model, const Eigen::Vecto
 
   errors.energy_gradient = relative(model.force(x, zero), -fd_gradient);
   return errors;
+}
+
+double FieldCallErrors::worst() const {
+  return std::max({force_parts, product_parts, diagonal_blocks, tangent_product,
+                   tangent_pair_product, tangent_blocks, tangent_force, outside_nodes});
+}
+
+FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd& x,
+                                  const Eigen::VectorXd& v) {
+  const Eigen::Index n = field.num_dofs();
+  const int nodes = static_cast<int>(n / 3);
+  const Linearisation definite = Linearisation::definite;
+  const Eigen::VectorXd dx = random_direction(n, 11), dx2 = random_direction(n, 12);
+  Eigen::VectorXd force = Eigen::VectorXd::Zero(n), product = force, product2 = force;
+  field.add_force(x, v, force);
+  field.add_dfdx_product(x, v, dx, product, definite);
+  field.add_dfdx_product(x, v, dx2, product2, definite);
+  const double cx = -2.0, cv = -0.5;
+  const Eigen::MatrixXd jacobian =
+      cx * Eigen::MatrixXd(field.dfdx(x, v, definite)) + cv * Eigen::MatrixXd(field.dfdv(x));
+  Eigen::MatrixXd blocks_expected = Eigen::MatrixXd::Zero(n, 3);
+  for (int i = 0; i < nodes; ++i)
+    blocks_expected.middleRows<3>(3 * i) = jacobian.block<3, 3>(3 * i, 3 * i);
+  auto stacked = [&](const std::vector<Eigen::Matrix3d>& blocks) {
+    Eigen::MatrixXd s(n, 3);
+    for (int i = 0; i < nodes; ++i)
+      s.middleRows<3>(3 * i) = blocks[i];
+    return s;
+  };
+  auto worse = [](double& slot, double value) { slot = std::max(slot, value); };
+
+  FieldCallErrors e;
+  std::vector<Eigen::Matrix3d> blocks(nodes, Eigen::Matrix3d::Zero());
+  field.add_diagonal_blocks(x, v, cx, cv, blocks, definite);
+  e.diagonal_blocks = relative(blocks_expected, stacked(blocks));
+  for (int parts = 1; parts <= 3; ++parts) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(n), df = f, tf = f, tdf = f, tdf1 = f, tdf2 = f;
+    std::vector<Eigen::Matrix3d> tangent_blocks(nodes, Eigen::Matrix3d::Zero());
+    const auto tangent = field.tangent(x, v, definite);
+    bool gives_force = true;
+    for (int part = 0; part < parts; ++part) {
+      field.add_force_part(x, v, f, part, parts);
+      field.add_dfdx_product_part(x, v, dx, df, definite, part, parts);
+      tangent->set_part(part, parts);
+    }
+    for (int part = 0; part < parts; ++part) {
+      tangent->add_product_part(dx, tdf, part, parts);
+      tangent->add_product_pair_part(dx, tdf1, dx2, tdf2, part, parts);
+      tangent->add_diagonal_blocks_part(cx, cv, tangent_blocks, part, parts);
+      gives_force = tangent->add_force_part(tf, part, parts) && gives_force;
+    }
+    worse(e.force_parts, relative(force, f));
+    worse(e.product_parts, relative(product, df));
+    worse(e.tangent_product, relative(product, tdf));
+    worse(e.tangent_pair_product, std::max(relative(product, tdf1), relative(product2, tdf2)));
+    worse(e.tangent_blocks, relative(blocks_expected, stacked(tangent_blocks)));
+    if (gives_force) worse(e.tangent_force, relative(force, tf));
+  }
+  std::vector<char> on(nodes, 0);
+  for (int i : field.nodes())
+    on[i] = 1;
+  double outside = 0.0;
+  for (int i = 0; i < nodes; ++i)
+    if (!on[i]) outside += force.segment<3>(3 * i).norm() + product.segment<3>(3 * i).norm();
+  e.outside_nodes = outside / std::max(force.norm(), 1e-300);
+  return e;
 }
 
 }  // namespace msfem::massspring::testing

@@ -25,4 +25,23 @@ Eigen::VectorXd perturbed(const Eigen::VectorXd& x, double amplitude, unsigned s
 JacobianErrors check_force_jacobians(const ForceModel& model, const Eigen::VectorXd& x,
                                      const Eigen::VectorXd& v, double step);
 
+/// The calls a solver makes of a ForceField beyond ForceModel's, each against the whole call it
+/// stands for (relative errors): parts summed over 1, 2 and 3 parts against add_force and
+/// add_dfdx_product (definite), the diagonal blocks against the assembled Jacobians' 3x3 diagonal
+/// blocks, and the kept tangent (set in parts, then its products, pair products, blocks and, where
+/// it gives one, force) against the same; and forces or products outside nodes() (must be zero).
+struct FieldCallErrors {
+  double force_parts = 0.0;
+  double product_parts = 0.0;
+  double diagonal_blocks = 0.0;
+  double tangent_product = 0.0;
+  double tangent_pair_product = 0.0;
+  double tangent_blocks = 0.0;
+  double tangent_force = 0.0;
+  double outside_nodes = 0.0;  ///< |force and product off the field's nodes| / |force|
+  double worst() const;
+};
+FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd& x,
+                                  const Eigen::VectorXd& v);
+
 }  // namespace msfem::massspring::testing

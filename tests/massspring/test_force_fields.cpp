@@ -1,7 +1,7 @@
-// A model is its springs plus a list of named force fields: a field a simulator adds joins every
-// ForceModel call (force, energy, both Jacobians, as products and as triplets), replaces a field of
-// its name in place, scales by its coefficient groups, and is refused by name where a solver
-// cannot run it.
+// A model is its springs plus a list of force fields found by their type: a field a simulator adds
+// joins every ForceModel call (force, energy, both Jacobians, as products and as triplets),
+// replaces a field of its type in place, scales by its coefficient groups, and is refused by name
+// where a solver cannot run it.
 #include <gtest/gtest.h>
 
 #include "force_jacobian_check.hpp"
@@ -56,6 +56,7 @@ class RestTether : public ForceField {
       t.emplace_back(i, i, -c_);
   }
   const std::vector<int>& nodes() const override { return nodes_; }
+  std::string name() const override { return "tether"; }
   std::vector<std::string> coefficient_groups() const override { return {"tether"}; }
   std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const override {
     if (group != "tether") return ForceField::scaled(group, factor);
@@ -82,7 +83,7 @@ MassSpringModel tethered_model() {
   for (int node = 0; node < model.num_nodes(); ++node)
     if (rest.segment<3>(3 * node).norm() < 0.03) model.fix_node(node);
   model.set_gravity(Eigen::Vector3d(0, 0, -9.81));
-  model.set_field("tether", std::make_shared<RestTether>(rest, 50.0, 0.02));
+  model.set_field<RestTether>(std::make_shared<RestTether>(rest, 50.0, 0.02));
   return model;
 }
 
@@ -102,7 +103,7 @@ TEST(ForceFields, AFieldJoinsEveryForceModelCall) {
   const Eigen::VectorXd dx = perturbed(0 * rest, 1.0, 9);
   const MassSpringModel springs_only = model;
   const double k = 40.0, c = 0.3;
-  model.set_field("tether", std::make_shared<RestTether>(rest, k, c));
+  model.set_field<RestTether>(std::make_shared<RestTether>(rest, k, c));
   ASSERT_EQ(model.fields().size(), 1u);
   EXPECT_EQ(model.field_names(), "tether");
 
@@ -125,30 +126,29 @@ TEST(ForceFields, AFieldJoinsEveryForceModelCall) {
   EXPECT_LT(errors.energy_gradient, 1e-5);
 }
 
-TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByName) {
+TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByType) {
   MassSpringModel model = three_tier_model();
   const Eigen::VectorXd rest = model.rest_state(), x = perturbed(rest, 0.002, 3);
   const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
   const MassSpringModel springs_only = model;
   auto tether = std::make_shared<RestTether>(rest, 10.0, 0.0);
-  model.set_field("tether", tether);
+  model.set_field<RestTether>(tether);
   const auto& nv = model.network().surface_nodes;
   model.set_volume(VolumeForceField(
       model.num_nodes(),
       tier_prisms(model.network().rest_positions, model.network().surface_triangles,
                   static_cast<int>(nv.size()), 3, 500.0)));
-  model.set_field("tether", tether->scaled("tether", 3.0));
-  ASSERT_EQ(model.field_names(), "tether, volume");  // replaced where it was
+  model.set_field<RestTether>(tether->scaled("tether", 3.0));
+  ASSERT_EQ(model.field_names(), "tether, volume preservation");  // replaced where it was
   const MassSpringModel with_volume_only = [&] {
     MassSpringModel m = model;
-    m.clear_field("tether");
+    m.clear_fields<RestTether>();
     return m;
   }();
   const Eigen::VectorXd tether_force = model.force(x, v) - with_volume_only.force(x, v);
   EXPECT_LT((tether_force + 30.0 * (x - rest)).norm(), 1e-9 * 30.0 * (x - rest).norm());
   EXPECT_THROW(tether->scaled("volume", 2.0), ModelError);
-  EXPECT_THROW(model.set_field("short", std::make_shared<RestTether>(rest.head(6), 1.0, 0.0)),
-               ModelError);
+  EXPECT_THROW(model.add_field(std::make_shared<RestTether>(rest.head(6), 1.0, 0.0)), ModelError);
   // Copies share fields but not the list: clearing one copy's leaves the other's.
   EXPECT_EQ(springs_only.fields().size(), 0u);
   EXPECT_NE(model.volume(), nullptr);
@@ -176,7 +176,7 @@ TEST(ForceFields, FastSteppersStepFieldsAndLinearStaticsWeighEach) {
   EXPECT_LT((stepped.v - generic.v).norm(), 1e-9 * generic.v.norm());
   // The field matters here: without it the same steps end elsewhere.
   MassSpringModel springs_only = model;
-  springs_only.clear_field("tether");
+  springs_only.clear_fields<RestTether>();
   FastExplicitStepper blind(springs_only, FastStepperOptions{2, false, true, true});
   blind.set_state(start);
   blind.step(dt, 300);
@@ -242,7 +242,7 @@ TEST(ForceFields, FastRk4TakesTheFieldAtEveryStage) {
       EXPECT_LT((stepped.v - generic.v).norm(), tolerance * generic.v.norm()) << threads;
     }
   MassSpringModel springs_only = model;
-  springs_only.clear_field("tether");
+  springs_only.clear_fields<RestTether>();
   FastStepperOptions options;
   options.integrator = IntegratorKind::rk4;
   FastExplicitStepper blind(springs_only, options);

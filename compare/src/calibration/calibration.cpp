@@ -139,14 +139,16 @@ StaticSolution equilibrium(BuiltVariant& variant, const CalibrationLoad& referen
   return solve_variant_static(variant, x);
 }
 
+// A field at its place in the model's list.
+using PlacedField = std::pair<std::size_t, std::shared_ptr<const ms::ForceField>>;
+
 std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<CalibrationLoad>& references,
                                      const Eigen::VectorXd& stiffness,
-                                     const std::vector<ms::MassSpringModel::NamedField>& fields,
-                                     double path_step) {
+                                     const std::vector<PlacedField>& fields, double path_step) {
   return shared_errors(references.size(), [&](std::size_t i) {
     m.variants[i].model->set_stiffness(stiffness);
-    for (const auto& field : fields)
-      m.variants[i].model->set_field(field.name, field.field);
+    for (const auto& [place, field] : fields)
+      m.variants[i].model->replace_field(place, field);
     // A frictionless tool's penalty is picked from the stiffness, as msfem run picks it for the
     // fitted model.
     m.variants[i].contact_pressure_penalty = 0.0;
@@ -158,24 +160,43 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<Calibratio
 }
 
 // The groups to fit (all the variant's when none is named), checked against the variant's own:
-// its spring groups, and the volume modulus when it has volume elements.
+// its spring groups and its fields' coefficient groups (the volume modulus, a simulator's own
+// field's). The linearised fit weighs each field as one part: one fitted group per field.
 std::vector<std::string> checked_groups(const BuiltVariant& base, const std::string& file,
                                         const std::string& variant_name,
                                         const CalibrationOptions& options) {
   std::vector<std::string> fittable = base.model->network().spring_group_names;
   for (const auto& field : base.model->fields())
-    for (const std::string& group : field.field->coefficient_groups())
+    for (const std::string& group : field->coefficient_groups())
       fittable.push_back(group);
   std::vector<std::string> groups = options.groups;
   if (groups.empty()) groups = fittable;
   std::string known;
   for (const auto& g : fittable)
     known += (known.empty() ? "" : ", ") + g;
-  for (const auto& g : groups)
-    if (std::count(fittable.begin(), fittable.end(), g) != 1)
+  for (const auto& g : groups) {
+    const auto count = std::count(fittable.begin(), fittable.end(), g);
+    if (count == 0)
       throw cases::InputError(file + ": calibration: variant " + variant_name + " has no group '" +
                               g + "' (its groups: " + known +
                               (g == volume_group ? "; " + std::string(volume_hint) : "") + ")");
+    if (count > 1)
+      throw cases::InputError(file + ": calibration: variant " + variant_name + " names group '" +
+                              g + "' " + std::to_string(count) +
+                              " times among its spring groups and fields (its groups: " + known +
+                              "): a fit cannot tell which to scale");
+  }
+  for (const auto& field : base.model->fields()) {
+    int fitted = 0;
+    for (const std::string& group : field->coefficient_groups())
+      fitted += std::count(groups.begin(), groups.end(), group) > 0;
+    if (options.linear && fitted > 1)
+      throw cases::InputError(file +
+                              ": calibration: the linearised fit scales a field as one "
+                              "part, and " +
+                              field->name() + " has " + std::to_string(fitted) +
+                              " groups to fit: fit them without --linear");
+  }
   for (std::size_t i = 0; i < groups.size(); ++i)
     if (std::count(groups.begin(), groups.end(), groups[i]) > 1)
       throw cases::InputError(file + ": calibration: group '" + groups[i] + "' is listed twice");
@@ -185,9 +206,10 @@ std::vector<std::string> checked_groups(const BuiltVariant& base, const std::str
 }
 
 // The fit's parameters θ: each fitted spring group's stiffness is k_start · exp(θ_g), so it stays
-// positive and a factor of 2 too stiff weighs as much as a factor of 2 too soft; the volume
-// modulus is scaled uniformly, the case's times the start factor times exp(θ_volume). Evaluated on
-// one model per load, nonlinear or linearised at rest.
+// positive and a factor of 2 too stiff weighs as much as a factor of 2 too soft; a field's group
+// (the volume modulus, a simulator's own field's) is scaled uniformly, the case's coefficients
+// times the start factor times exp(θ_g). Evaluated on one model per load, nonlinear or linearised
+// at rest.
 class GroupFit {
  public:
   GroupFit(const Problem& problem, const BuiltVariant& base, std::vector<std::string> groups,
@@ -199,21 +221,25 @@ class GroupFit {
         options_(options),
         n_(static_cast<int>(groups_.size())),
         group_id_(n_, -1),
+        field_of_(n_, -1),
+        start_factor_(n_, 1.0),
         case_stiffness_(network_.stiffness) {
+    const auto& spring_groups = network_.spring_group_names;
+    const auto& fields = base.model->fields();
     for (int g = 0; g < n_; ++g) {
-      if (groups_[g] == volume_group)
-        volume_index_ = g;
-      else
+      if (!options.start_factors.empty()) start_factor_[g] = options.start_factors[g];
+      if (std::find(spring_groups.begin(), spring_groups.end(), groups_[g]) != spring_groups.end())
         group_id_[g] = network_.spring_group_id(groups_[g]);
+      for (std::size_t f = 0; f < fields.size() && group_id_[g] < 0; ++f) {
+        const std::vector<std::string> named = fields[f]->coefficient_groups();
+        if (std::find(named.begin(), named.end(), groups_[g]) != named.end())
+          field_of_[g] = static_cast<int>(f);
+      }
     }
-    if (base.model->volume()) case_modulus_ = base.model->volume()->elements().modulus;
-    if (volume_index_ >= 0 && !options.start_factors.empty())
-      volume_start_factor_ = options.start_factors[volume_index_];
     start_stiffness_ = case_stiffness_;
-    for (int g = 0; g < n_ && !options.start_factors.empty(); ++g)
-      for (int s = 0; s < network_.num_springs(); ++s)
-        if (network_.spring_group[s] == group_id_[g])
-          start_stiffness_[s] *= options.start_factors[g];
+    for (int g = 0; g < n_; ++g)
+      for (int s = 0; s < network_.num_springs() && group_id_[g] >= 0; ++s)
+        if (network_.spring_group[s] == group_id_[g]) start_stiffness_[s] *= start_factor_[g];
   }
 
   int size() const { return n_; }
@@ -239,13 +265,17 @@ class GroupFit {
     if (!options_.linear)
       return evaluate_all(m, references, stiffness_at(theta), fields_at(theta),
                           path_step_of(problem_.parameters.loads.tool));
-    // Parts: the unfitted springs, each fitted spring group, and the volume (LinearisedStatics
-    // puts it last); the volume group's own part stays empty.
+    // Parts: the unfitted springs, each fitted spring group, and each field (LinearisedStatics
+    // puts them last); a field group's own spring part stays empty.
     std::vector<double> weights(n_ + 1, 1.0);
     for (int g = 0; g < n_; ++g)
       weights[g + 1] = std::exp(theta[g]);
-    for (const auto& field : base_.model->fields())
-      weights.push_back(names_volume_group(*field.field) ? volume_factor_at(theta) : 1.0);
+    for (std::size_t f = 0; f < base_.model->fields().size(); ++f) {
+      double weight = 1.0;
+      for (int g = 0; g < n_; ++g)
+        if (field_of_[g] == static_cast<int>(f)) weight = factor_at(theta, g);
+      weights.push_back(weight);
+    }
     return shared_errors(references.size(), [&](std::size_t i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
       return errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]);
@@ -260,14 +290,17 @@ class GroupFit {
       FittedGroup f;
       f.group = groups_[g];
       double k_start = 0, k_case = 0, k_fit = 0;
-      if (g == volume_index_) {
-        f.unit = "Pa";
-        f.springs = static_cast<int>(case_modulus_.size());
-        k_case = case_modulus_.sum();
-        k_start = k_case * volume_start_factor_;
-        k_fit = k_case * volume_factor_at(theta);
+      if (field_of_[g] >= 0) {
+        const ms::ForceField& field = *base_.model->fields()[field_of_[g]];
+        const std::vector<double> coefficients = field.coefficients(groups_[g]);
+        f.spring_group = false;
+        f.unit = field.coefficient_unit(groups_[g]);
+        f.springs = static_cast<int>(coefficients.size());
+        k_case = Eigen::Map<const Eigen::VectorXd>(coefficients.data(), f.springs).sum();
+        k_start = k_case * start_factor_[g];
+        k_fit = k_case * factor_at(theta, g);
       }
-      for (int s = 0; s < network_.num_springs() && g != volume_index_; ++s)
+      for (int s = 0; s < network_.num_springs() && group_id_[g] >= 0; ++s)
         if (network_.spring_group[s] == group_id_[g]) {
           ++f.springs;
           k_start += start_stiffness_[s];
@@ -295,22 +328,26 @@ class GroupFit {
         if (network_.spring_group[s] == group_id_[g]) k[s] *= std::exp(theta[g]);
     return k;
   }
+
   // The case's fields whose coefficient groups are fitted, scaled to their factors at θ.
-  std::vector<ms::MassSpringModel::NamedField> fields_at(const std::vector<double>& theta) const {
-    std::vector<ms::MassSpringModel::NamedField> scaled;
-    for (const auto& f : base_.model->fields())
-      if (names_volume_group(*f.field) && volume_index_ >= 0)
-        scaled.push_back({f.name, f.field->scaled(volume_group, volume_factor_at(theta))});
+  std::vector<PlacedField> fields_at(const std::vector<double>& theta) const {
+    std::vector<PlacedField> scaled;
+    for (std::size_t f = 0; f < base_.model->fields().size(); ++f) {
+      std::shared_ptr<const ms::ForceField> field = base_.model->fields()[f];
+      bool fitted = false;
+      for (int g = 0; g < n_; ++g)
+        if (field_of_[g] == static_cast<int>(f)) {
+          field = field->scaled(groups_[g], factor_at(theta, g));
+          fitted = true;
+        }
+      if (fitted) scaled.emplace_back(f, std::move(field));
+    }
     return scaled;
   }
 
-  static bool names_volume_group(const ms::ForceField& field) {
-    const std::vector<std::string> groups = field.coefficient_groups();
-    return std::find(groups.begin(), groups.end(), volume_group) != groups.end();
-  }
-
-  double volume_factor_at(const std::vector<double>& theta) const {
-    return volume_start_factor_ * (volume_index_ >= 0 ? std::exp(theta[volume_index_]) : 1.0);
+  // A field group's factor on the case's coefficients at θ.
+  double factor_at(const std::vector<double>& theta, int g) const {
+    return start_factor_[g] * std::exp(theta[g]);
   }
 
   const Problem& problem_;
@@ -319,12 +356,11 @@ class GroupFit {
   std::vector<std::string> groups_;
   const CalibrationOptions& options_;
   int n_;
-  std::vector<int> group_id_;  ///< spring group id of each fitted group; -1 for the volume group
-  int volume_index_ = -1;
+  std::vector<int> group_id_;  ///< spring group id of each fitted group; -1 for a field's group
+  std::vector<int> field_of_;  ///< the field (its place in the list) naming a field's group; -1
+  std::vector<double> start_factor_;
   Eigen::VectorXd case_stiffness_;   ///< analytic × the case's group scales
   Eigen::VectorXd start_stiffness_;  ///< × the start factors
-  Eigen::VectorXd case_modulus_;
-  double volume_start_factor_ = 1.0;
 };
 
 /// The lowest objective seen and where.
@@ -376,6 +412,12 @@ void optimise(const std::function<double(const std::vector<double>&)>& j, BestPo
   }
 }
 
+[[noreturn]] void throw_empty_training(const Problem& problem) {
+  throw cases::InputError(problem.parameters.file.string() +
+                          ": calibration: the training set is empty (give --train or "
+                          "calibration/train loads)");
+}
+
 }  // namespace
 
 LoadErrors evaluate_load(BuiltVariant& variant, const CalibrationLoad& reference,
@@ -404,13 +446,18 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                          const VariantSpec& variant, const std::vector<CalibrationLoad>& train,
                          const std::vector<CalibrationLoad>& test,
                          const CalibrationOptions& options) {
+  if (train.empty()) throw_empty_training(problem);
+  return calibrate(problem, build_variant(variant, problem, mesh, train.front().tool), train, test,
+                   options);
+}
+
+CalibrationFit calibrate(const Problem& problem, const BuiltVariant& base,
+                         const std::vector<CalibrationLoad>& train,
+                         const std::vector<CalibrationLoad>& test,
+                         const CalibrationOptions& options) {
   const auto start = Clock::now();
   const std::string& file = problem.parameters.file.string();
-  if (train.empty())
-    throw cases::InputError(file +
-                            ": calibration: the training set is empty (give --train or "
-                            "calibration/train loads)");
-  const BuiltVariant base = build_variant(variant, problem, mesh, train.front().tool);
+  if (train.empty()) throw_empty_training(problem);
   const GroupFit fitting(problem, base, checked_groups(base, file, base.name, options), options);
   LoadModels train_models = fitting.models_on(train);
   LoadModels test_models = fitting.models_on(test);

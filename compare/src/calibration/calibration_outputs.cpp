@@ -167,14 +167,18 @@ nlohmann::json calibration_json(const CaseCalibration& c) {
   for (const auto& g : c.fit.groups) {
     nlohmann::json entry = {
         {"group", g.group}, {"unit", g.unit}, {"factor", g.factor}, {"group_scale", g.case_factor}};
-    if (g.unit == "Pa") {  // the volume group: elements and the modulus κ
-      entry["elements"] = g.springs;
-      entry["start_modulus_Pa"] = g.start_stiffness_n_per_m;
-      entry["fitted_modulus_Pa"] = g.fitted_stiffness_n_per_m;
-    } else {
+    if (g.spring_group) {
       entry["springs"] = g.springs;
       entry["start_stiffness_N_per_m"] = g.start_stiffness_n_per_m;
       entry["fitted_stiffness_N_per_m"] = g.fitted_stiffness_n_per_m;
+    } else if (g.group == volume_group) {  // volume elements and their modulus κ
+      entry["elements"] = g.springs;
+      entry["start_modulus_Pa"] = g.start_stiffness_n_per_m;
+      entry["fitted_modulus_Pa"] = g.fitted_stiffness_n_per_m;
+    } else {  // another field's group: its coefficients' mean
+      entry["coefficients"] = g.springs;
+      entry["start_mean"] = g.start_stiffness_n_per_m;
+      entry["fitted_mean"] = g.fitted_stiffness_n_per_m;
     }
     coefficients.push_back(entry);
   }

@@ -328,7 +328,7 @@ HapticReplay replay_once(BuiltVariant& variant, const cases::CaseParameters& par
   out.model_dt_s = dt;
   const std::shared_ptr<ms::ToolContact> contact = model.contact()->clone();
   contact->move_tool(path.at(path.start()));
-  model.set_field(ms::MassSpringModel::contact_field, contact);
+  model.set_field<ms::ToolContact>(contact);
   const int cores = static_cast<int>(std::max(2u, std::thread::hardware_concurrency()));
   out.model_threads = settings.model_threads > 0 ? settings.model_threads : std::min(2, cores - 1);
   VariantStepper stepper(model, parameters.timing.integrator, ms::initial_state(model),

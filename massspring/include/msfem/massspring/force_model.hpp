@@ -70,12 +70,29 @@ class ForceField : public ForceModel {
   /// dx) the field reads (the static solver's node relaxation leaves them to Newton, unless it
   /// knows the field; the fast steppers gather x, v and dx at these nodes only).
   virtual const std::vector<int>& nodes() const = 0;
+  /// What messages call this field ("volume preservation", "tool contact", ...).
+  virtual std::string name() const { return "force field"; }
   /// Names of the coefficient groups a fit may scale, each one factor on a set of stiffnesses
   /// (volume preservation: "volume"); none by default.
   virtual std::vector<std::string> coefficient_groups() const { return {}; }
   /// This field with `group`'s coefficients multiplied by `factor`; throws ModelError for a group
   /// it does not have.
   virtual std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const;
+  /// The coefficients `group` scales, for a fit to report (their mean, before and after), and
+  /// their unit. By default one coefficient 1 without unit: the fit reports the factor alone.
+  virtual std::vector<double> coefficients(const std::string& group) const;
+  virtual std::string coefficient_unit(const std::string& /*group*/) const { return "1"; }
+  /// True for a field whose energy is a sum of one term per node, each depending on that node's
+  /// position alone (a sphere's contact with nodes): the static solver then relaxes its nodes one
+  /// at a time with their springs (add_node_term). False by default: the field's nodes are left to
+  /// the global Newton iterations.
+  virtual bool nodewise() const { return false; }
+  /// For a nodewise field: node `node`'s term at position p, its force added to f and its
+  /// stiffness -∂f/∂p to k; returns the term's energy.
+  virtual double add_node_term(int /*node*/, const Eigen::Vector3d& /*p*/, Eigen::Vector3d& /*f*/,
+                               Eigen::Matrix3d& /*k*/) const {
+    return 0.0;
+  }
   /// Part `part` of `parts` of add_force, so that threads each adding one part into their own f
   /// together add the whole force (the fast explicit stepper shares a field among its threads this
   /// way). By default part 0 is the whole force and the other parts are nothing.

@@ -25,7 +25,8 @@ class LinearisedStatics {
   /// part 0, whose weight should stay 1); the model's constraints
   /// (supports and the tool's prescribed patch) and loads are those of `model`. A model with
   /// force fields (volume preservation) gets one more part per field, after the given ones and in
-  /// the model's field order, holding that field alone.
+  /// the model's field order, holding that field alone: its weight scales the field's Jacobian and
+  /// its force at rest (a field that pulls at rest, as a grasper does, is linear in its weight).
   /// `factorization` makes the sparse Cholesky factor (empty: Eigen's SimplicialLDLT), as
   /// StaticOptions::factorization.
   LinearisedStatics(const MassSpringModel& model, const std::vector<Eigen::VectorXd>& parts,
@@ -51,8 +52,9 @@ class LinearisedStatics {
   std::vector<Eigen::SparseMatrix<double>> free_stiffness_;  ///< −∂f/∂x of each part, free dofs
   std::vector<Eigen::VectorXd> free_load_;  ///< each part's force from the prescribed u, free dofs
   Eigen::SparseMatrix<double> select_;      ///< free dofs × all dofs
-  Eigen::VectorXd rest_force_;              ///< f at rest (gravity, external)
-  Eigen::VectorXd prescribed_;              ///< u on the constrained dofs, 0 elsewhere
+  Eigen::VectorXd rest_force_;              ///< f at rest (gravity, external, the fields')
+  std::vector<Eigen::VectorXd> field_rest_force_;  ///< each part's field's f at rest (or empty)
+  Eigen::VectorXd prescribed_;                     ///< u on the constrained dofs, 0 elsewhere
   std::unique_ptr<detail::TangentFactor> cholesky_;
 };
 

@@ -57,33 +57,55 @@ class MassSpringModel : public ForceModel {
   /// Where a constrained node is held: rest position + prescribed displacement.
   Eigen::Vector3d constrained_target(int node) const;
 
-  // --- force fields beyond the springs, summed in list order ---
-  struct NamedField {
-    std::string name;
-    std::shared_ptr<const ForceField> field;
-  };
-  /// Puts `field` in the list under `name`, replacing a field of that name in its place. Throws
-  /// ModelError if it is not built for this model's nodes.
-  void set_field(const std::string& name, std::shared_ptr<const ForceField> field);
-  void clear_field(const std::string& name);
-  /// The field named `name`, or null.
-  const ForceField* field(const std::string& name) const;
-  const std::vector<NamedField>& fields() const { return fields_; }
-  /// The fields' names, comma-separated, for messages.
+  // --- force fields beyond the springs, summed in list order, found by their type ---
+  using FieldList = std::vector<std::shared_ptr<const ForceField>>;
+  const FieldList& fields() const { return fields_; }
+  /// Appends `field` to the list. Throws ModelError if it is not built for this model's nodes.
+  void add_field(std::shared_ptr<const ForceField> field);
+  /// Puts `field` in the list's place `index` (a fitted copy of the field there, say).
+  void replace_field(std::size_t index, std::shared_ptr<const ForceField> field);
+  /// The first field that is a `Field` (a class or an interface), or null.
+  template <class Field>
+  const Field* find_field() const {
+    const int index = field_index<Field>();
+    return index < 0 ? nullptr : dynamic_cast<const Field*>(fields_[index].get());
+  }
+  /// The list's place of the first field that is a `Field`, or -1.
+  template <class Field>
+  int field_index() const {
+    for (std::size_t i = 0; i < fields_.size(); ++i)
+      if (dynamic_cast<const Field*>(fields_[i].get())) return static_cast<int>(i);
+    return -1;
+  }
+  /// Puts `field` in the place of the first field that is a `Field`, or appends it.
+  template <class Field>
+  void set_field(std::shared_ptr<const ForceField> field) {
+    const int index = field_index<Field>();
+    if (index < 0)
+      add_field(std::move(field));
+    else
+      replace_field(static_cast<std::size_t>(index), std::move(field));
+  }
+  /// Removes every field that is a `Field`.
+  template <class Field>
+  void clear_fields() {
+    for (int index = field_index<Field>(); index >= 0; index = field_index<Field>())
+      fields_.erase(fields_.begin() + index);
+  }
+  /// The fields' names (ForceField::name), comma-separated, for messages.
   std::string field_names() const;
 
-  // --- the two fields msfem builds, by their names ---
-  /// Tool contact (penalty, frictionless), field "contact": nodes only, or the surface's triangles.
+  // --- the two fields msfem builds ---
+  /// Tool contact (penalty, frictionless): nodes only, or the surface's triangles; replaces the
+  /// model's tool contact if it has one.
   void set_contact(const SphereContactForceField& contact);
   void set_contact(const SurfaceContactForceField& contact);
-  void clear_contact() { clear_field(contact_field); }
-  const ToolContact* contact() const;
-  /// Volume preservation (the bulk stiffness central springs lack), field "volume".
+  void clear_contact() { clear_fields<ToolContact>(); }
+  const ToolContact* contact() const { return find_field<ToolContact>(); }
+  /// Volume preservation (the bulk stiffness central springs lack); replaces the model's.
   void set_volume(const VolumeForceField& volume);
-  void clear_volume() { clear_field(volume_field); }
-  const VolumeForceField* volume() const;
-  static constexpr const char* contact_field = "contact";
-  static constexpr const char* volume_field = "volume";
+  void clear_volume() { clear_fields<VolumeForceField>(); }
+  const VolumeForceField* volume() const { return find_field<VolumeForceField>(); }
 
   // --- ForceModel ---
   int num_dofs() const override { return 3 * num_nodes(); }
@@ -127,7 +149,7 @@ class MassSpringModel : public ForceModel {
   Eigen::MatrixX3d external_force_;
   std::vector<char> constrained_;
   Eigen::MatrixX3d prescribed_displacement_;
-  std::vector<NamedField> fields_;  ///< shared by copies: a field is immutable
+  FieldList fields_;  ///< shared by copies: a field is immutable
 };
 
 }  // namespace msfem::massspring

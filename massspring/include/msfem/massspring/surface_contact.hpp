@@ -48,6 +48,7 @@ class SurfaceContactForceField : public ToolContact {
 
   const SphereTool& tool() const override { return tool_; }
   const std::vector<int>& nodes() const override { return nodes_; }
+  std::string name() const override { return "tool contact (surface)"; }
   double penalty_stiffness() const override { return pressure_penalty_ * mean_node_area_; }
   std::shared_ptr<ToolContact> clone() const override {
     return std::make_shared<SurfaceContactForceField>(*this);  // shares the rest-state k-d tree

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "msfem/massspring/force_model.hpp"
@@ -72,7 +73,11 @@ class SphereContactForceField : public ToolContact {
 
   const SphereTool& tool() const override { return tool_; }
   const std::vector<int>& nodes() const override { return nodes_; }
+  std::string name() const override { return "tool contact (nodes)"; }
   double penalty_stiffness() const override { return penalty_; }
+  bool nodewise() const override { return true; }
+  double add_node_term(int node, const Eigen::Vector3d& p, Eigen::Vector3d& f,
+                       Eigen::Matrix3d& k) const override;
   std::shared_ptr<ToolContact> clone() const override {
     return std::make_shared<SphereContactForceField>(*this);
   }

@@ -67,7 +67,11 @@ class VolumeForceField : public ForceField {
   /// The nodes of its elements.
   const std::vector<int>& nodes() const override { return nodes_; }
   /// "volume": every element's modulus.
+  std::string name() const override { return "volume preservation"; }
   std::vector<std::string> coefficient_groups() const override { return {"volume"}; }
+  /// The elements' moduli (Pa).
+  std::vector<double> coefficients(const std::string& group) const override;
+  std::string coefficient_unit(const std::string&) const override { return "Pa"; }
   std::shared_ptr<const ForceField> scaled(const std::string& group, double factor) const override;
 
   const VolumeElements& elements() const { return elements_; }

@@ -52,8 +52,11 @@ struct ErrorsOnLoads {
 
 struct FittedGroup {
   std::string group;
-  int springs = 0;  ///< springs in the group (volume elements for the volume group)
-  /// "N/m" for a spring group; "Pa" for the volume group, whose "stiffness" is the modulus κ.
+  int springs = 0;  ///< springs in the group (a field group: its coefficients, volume elements)
+  /// A spring group, or a force field's coefficient group (volume preservation's modulus, a
+  /// simulator's own field's), whose "stiffness" is the mean of its coefficients.
+  bool spring_group = true;
+  /// "N/m" for a spring group; the field's unit for a field group ("Pa" for the volume modulus κ).
   std::string unit = "N/m";
   double start_stiffness_n_per_m = 0.0;  ///< mean over the group's springs, at the start
   double factor = 1.0;                   ///< fitted / start
@@ -102,6 +105,13 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                          const CalibrationOptions& options);
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
                          cases::Variant variant, const std::vector<CalibrationLoad>& train,
+                         const std::vector<CalibrationLoad>& test,
+                         const CalibrationOptions& options);
+/// The same on a variant already built on `problem` (at the first training load's tool), with
+/// whatever fields its model holds: a field a simulator adds is fitted by its coefficient groups
+/// like the model's own.
+CalibrationFit calibrate(const Problem& problem, const BuiltVariant& base,
+                         const std::vector<CalibrationLoad>& train,
                          const std::vector<CalibrationLoad>& test,
                          const CalibrationOptions& options);
 
