@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "msfem/massspring/mass_spring_model.hpp"
-#include "node_gather_layout.hpp"
+#include "kernels/node_gather_layout.hpp"
 
 namespace msfem::massspring::detail {
 

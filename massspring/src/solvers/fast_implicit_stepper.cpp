@@ -7,11 +7,11 @@
 #include <chrono>
 #include <cmath>
 
-#include "adaptive_threads.hpp"
-#include "gather_kernels.hpp"
+#include "kernels/adaptive_threads.hpp"
+#include "kernels/gather_kernels.hpp"
 #include "implicit_fields.hpp"
-#include "soa_layout.hpp"
-#include "thread_team.hpp"
+#include "kernels/soa_layout.hpp"
+#include "kernels/thread_team.hpp"
 
 namespace msfem::massspring {
 

@@ -9,12 +9,12 @@
 #include <sstream>
 #include <type_traits>
 
-#include "adaptive_threads.hpp"
-#include "gather_kernels.hpp"
+#include "kernels/adaptive_threads.hpp"
+#include "kernels/gather_kernels.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/stability.hpp"
-#include "soa_layout.hpp"
-#include "thread_team.hpp"
+#include "kernels/soa_layout.hpp"
+#include "kernels/thread_team.hpp"
 
 namespace msfem::massspring {
 

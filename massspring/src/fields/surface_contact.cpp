@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "kd_tree.hpp"
+#include "geometry/kd_tree.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
 

@@ -16,7 +16,7 @@
 #include <queue>
 #include <utility>
 
-#include "kd_tree.hpp"
+#include "geometry/kd_tree.hpp"
 #include "msfem/massspring/surface_geometry.hpp"
 #include "msfem/massspring/topology_builders.hpp"
 
