@@ -7,9 +7,9 @@
 #include <chrono>
 #include <cmath>
 
+#include "implicit_fields.hpp"
 #include "kernels/adaptive_threads.hpp"
 #include "kernels/gather_kernels.hpp"
-#include "implicit_fields.hpp"
 #include "kernels/soa_layout.hpp"
 #include "kernels/thread_team.hpp"
 

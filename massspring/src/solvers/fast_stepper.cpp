@@ -11,10 +11,10 @@
 
 #include "kernels/adaptive_threads.hpp"
 #include "kernels/gather_kernels.hpp"
-#include "msfem/massspring/errors.hpp"
-#include "msfem/massspring/stability.hpp"
 #include "kernels/soa_layout.hpp"
 #include "kernels/thread_team.hpp"
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/stability.hpp"
 
 namespace msfem::massspring {
 

@@ -13,8 +13,8 @@
 #include <memory>
 #include <vector>
 
-#include "msfem/massspring/mass_spring_model.hpp"
 #include "kernels/node_gather_layout.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 
 namespace msfem::massspring::detail {
 
