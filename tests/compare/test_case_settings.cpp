@@ -180,7 +180,8 @@ TEST(CaseSettings, VariantStiffnessModelAndInnerTiersChangeTheNetwork) {
   for (const cases::Variant kind : cases::all_values<cases::Variant>()) {
     const BuiltVariant v = build_variant(kind, problem, mesh, std::nullopt);
     EXPECT_EQ(v.name, name_of(kind));
-    EXPECT_EQ(v.model->network().spring_group_names, spring_groups_of(kind)) << v.name;
+    EXPECT_EQ(v.model->network().spring_group_names, spring_groups_of(kind, problem.parameters))
+        << v.name;
   }
   auto network_with = [&](const std::string& setting, cases::Variant kind) {
     Problem changed = problem;

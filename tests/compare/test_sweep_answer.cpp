@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "msfem/compare/pipeline/sweep.hpp"
+#include "msfem/compare/writers/sweep_report.hpp"
 
 namespace msfem::compare {
 namespace {

@@ -157,22 +157,39 @@ nlohmann::json to_json(const massspring::BenchmarkCase& c,
           {"warnings", warnings}};
 }
 
-int bench_massspring(const Options& options) {
-  const bool json = options.flag("json");
+// The brain surface the brain cases are built on, or none (a sphere of its size stands in).
+std::optional<cases::Surface> brain_surface(const Options& options) {
   const std::filesystem::path mesh_dir =
       options.value("mesh-dir").value_or(std::string(MSFEM_DEFAULT_CASES_DIR) + "/data");
   const std::filesystem::path brain_path = mesh_dir / kBrainFile;
+  if (std::filesystem::exists(brain_path))
+    return cases::read_surface(brain_path, cases::LengthUnit::millimetre);
+  std::cerr << "msfem bench: " << brain_path.string()
+            << " not found; brain_scale uses a geodesic sphere of the same size\n";
+  return std::nullopt;
+}
 
+// The roofline at a working set: the triad at each size, on the stepper's threads. A step whose
+// bytes fit the caches is held to the caches' bandwidth, not memory's.
+nlohmann::json cache_ladder(int threads, bool print) {
+  nlohmann::json ladder = nlohmann::json::array();
+  for (const double megabytes : {0.25, 1.0, 4.0, 12.0, 32.0, 128.0}) {
+    const auto bytes = static_cast<std::size_t>(megabytes * 1e6);
+    const double rate = massspring::triad_bandwidth_at(bytes, threads);
+    ladder.push_back({{"bytes", bytes}, {"triad_bytes_per_second", rate}});
+    if (print) std::printf("triad at %7.2f MB: %7.2f GB/s\n", megabytes, 1e-9 * rate);
+  }
+  return ladder;
+}
+
+int bench_massspring(const Options& options) {
+  const bool json = options.flag("json");
   const std::vector<std::string> wanted = wanted_cases(options);
   std::optional<Eigen::MatrixX3d> brain_vertices;
   std::optional<Eigen::MatrixX3i> brain_triangles;
-  if (std::filesystem::exists(brain_path)) {
-    const cases::Surface brain = cases::read_surface(brain_path, cases::LengthUnit::millimetre);
-    brain_vertices = brain.vertices;
-    brain_triangles = brain.triangles;
-  } else {
-    std::cerr << "msfem bench: " << brain_path.string()
-              << " not found; brain_scale uses a geodesic sphere of the same size\n";
+  if (const auto brain = brain_surface(options)) {
+    brain_vertices = brain->vertices;
+    brain_triangles = brain->triangles;
   }
 
   massspring::SteppingBenchmarkOptions bench_options;
@@ -186,15 +203,7 @@ int bench_massspring(const Options& options) {
   // The roofline: a memory-bound step can go no faster than this machine streams its bytes.
   const double stream = massspring::stream_triad_bandwidth(bench_options.threads);
   if (!json) std::printf("stream triad bandwidth %.2f GB/s\n", 1e-9 * stream);
-  // The roofline at a working set: the triad at that size, on the stepper's threads. A step whose
-  // bytes fit the caches is held to the caches' bandwidth, not memory's.
-  nlohmann::json ladder = nlohmann::json::array();
-  for (const double megabytes : {0.25, 1.0, 4.0, 12.0, 32.0, 128.0}) {
-    const auto bytes = static_cast<std::size_t>(megabytes * 1e6);
-    const double rate = massspring::triad_bandwidth_at(bytes, bench_options.threads);
-    ladder.push_back({{"bytes", bytes}, {"triad_bytes_per_second", rate}});
-    if (!json) std::printf("triad at %7.2f MB: %7.2f GB/s\n", megabytes, 1e-9 * rate);
-  }
+  const nlohmann::json ladder = cache_ladder(bench_options.threads, !json);
   nlohmann::json cases_json = nlohmann::json::array();
   for (const auto& c : built_cases(wanted, brain_vertices, brain_triangles)) {
     const auto result = massspring::run_benchmark_case(c, bench_options);

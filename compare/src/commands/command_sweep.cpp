@@ -15,7 +15,7 @@
 #include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/pipeline/sweep.hpp"
 #include "msfem/compare/writers/atomic_file.hpp"
-#include "msfem/compare/writers/plots.hpp"
+#include "msfem/compare/writers/sweep_report.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/integrators.hpp"
 
@@ -53,17 +53,6 @@ double positive_number(const std::string& option, const std::string& text) {
   if (used != text.size() || !(v > 0) || !std::isfinite(v))
     throw std::invalid_argument("option --" + option + ": '" + text + "' is not a positive number");
   return v;
-}
-
-// Colour per variant, marker per integrator, the configurations that keep a 1 kHz loop ringed.
-std::filesystem::path pareto_plot(const std::filesystem::path& file, const std::string& name,
-                                  const std::vector<SweepPoint>& points) {
-  std::vector<ParetoPoint> pareto_points;
-  for (const auto& p : points)
-    pareto_points.push_back({p.model() + " " + p.integrator + " @" + std::to_string(p.resolution),
-                             p.realtime_factor, p.rel_l2_error, p.model(), p.integrator,
-                             keeps_real_time(p, 1000.0)});
-  return pareto(file, "Relative error against real-time factor: " + name, pareto_points);
 }
 
 // --volume-preservation off|on|both.
@@ -146,51 +135,10 @@ int sweep_command(const Arguments& args) {
   }
   fill_directory_atomically(final_dir, [&](const std::filesystem::path& work) {
     const SweepResult result = run_sweep(parameters, settings, cache);
-    const auto& points = result.points;
     failed = result.failed_resolutions;
     failed_variants = result.failed_variants;
-    const nlohmann::json j = sweep_json(parameters, result);
-    write_text_atomically(work / "sweep.json", j.dump(2) + "\n");
-    std::string plot_line = "(plots skipped: gnuplot is not installed)";
-    const std::vector<VariantConvergence> convergence = convergence_by_variant(points);
-    if (gnuplot_available()) {
-      const auto file = pareto_plot(work / "pareto.png", parameters.name, points);
-      plot_line = "![Pareto plot](" + file.filename().string() + ")";
-      std::vector<Series> series;
-      for (const auto& v : convergence) {
-        Series s{v.variant, {}, {}};
-        for (const auto& [vertices, error] : v.error_at_vertices) {
-          s.x.push_back(vertices);
-          s.y.push_back(error);
-        }
-        series.push_back(std::move(s));
-      }
-      const auto resolution_file =
-          xy_lines(work / "convergence.png", "Error against resolution: " + parameters.name,
-                   "surface vertices", "relative error (rel L2)", series, true, true);
-      plot_line += "\n\n![Error against resolution](" + resolution_file.filename().string() + ")";
-    }
-    const std::string answer = sweep_answer(points, max_error);
-    std::string table = sweep_table(points);
-    for (const auto& [resolution, why] : result.failed_resolutions)
-      table += "\n> **resolution " + std::to_string(resolution) +
-               " failed** and is left out of the table and plot: " + why + "\n";
-    for (const auto& f : result.failed_variants)
-      table += "\n> **" + f.model + " failed at resolution " + std::to_string(f.resolution) +
-               "** and is left out of the table and plot: " + f.error + "\n";
-    if (result.networks) table += "\n> " + result.networks->note + ".\n";
-    write_text_atomically(work / "report.md",
-                          "# msfem sweep: " + parameters.name + "\n\n" + answer +
-                              convergence_section(convergence) + "## Every configuration\n\n" +
-                              table +
-                              "\nrel L2 against the FEM at each resolution; steps/s at half of "
-                              "each integrator's measured stable step (median after warm-up); "
-                              "real-time factor = stable step × steps/s. On the plot, ringed "
-                              "points keep a 1 kHz loop in real time.\n\n" +
-                              plot_line + "\n");
-    printed << (opt.flag("json")
-                    ? j.dump(2) + "\n"
-                    : table + "\n" + answer + "results in " + final_dir.string() + "\n");
+    printed << write_sweep_outputs(work, parameters, result, max_error, opt.flag("json"));
+    if (!opt.flag("json")) printed << "results in " << final_dir.string() << "\n";
   });
   std::cout << printed.str();
   // The sweep's other resolutions and variants are written; a script still learns what is missing.

@@ -13,6 +13,7 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
+#include "pipeline/builtin_variants.hpp"
 #include "variant_share.hpp"
 
 namespace msfem::compare::detail {
@@ -21,20 +22,9 @@ namespace {
 // The nodes a variant will have, before it is built: the statics' cost grows with them (sparse
 // Cholesky, about the 1.5th power in a volume).
 double estimated_nodes(const CaseRun& run, const VariantSpec& spec) {
-  const auto surface = static_cast<double>(run.problem.surface.num_vertices());
   // A user's network is not read before it is built: as many nodes as the three tiers, most.
-  if (!spec.builtin) return 3.0 * surface;
-  switch (*spec.builtin) {
-    case cases::Variant::three_tier:
-      return 3.0 * surface;
-    case cases::Variant::tet_edges:
-      return static_cast<double>(run.mesh.vertices.rows());
-    case cases::Variant::skeleton:
-      return 1.1 * surface;
-    case cases::Variant::single_layer:
-      break;
-  }
-  return surface;
+  if (!spec.builtin) return 3.0 * static_cast<double>(run.problem.surface.num_vertices());
+  return builtin_variant(*spec.builtin).estimated_nodes(run.problem, run.mesh);
 }
 
 // Whether this rank presses variant v at load k: mine[v][k], dealt by cost, alike on every rank.

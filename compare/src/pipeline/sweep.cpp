@@ -15,7 +15,6 @@
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/writers/json_values.hpp"
-#include "msfem/compare/writers/run_summary.hpp"
 
 namespace msfem::compare {
 
@@ -92,28 +91,6 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   pt.fem_estimated_force_rel_error = load.fem_error.force_rel_error;
   pt.not_resolved_by_reference = unresolved_metrics(run, at_load, 0);
   return pt;
-}
-
-nlohmann::json point_json(const SweepPoint& p) {
-  return {{"variant", p.variant},
-          {"volume_preservation", p.volume_preservation},
-          {"contact_refinement_edge_m", json_or_null(p.contact_edge_m)},
-          {"integrator", p.integrator},
-          {"stepper", p.stepper},
-          {"resolution", p.resolution},
-          {"surface_vertices", p.surface_vertices},
-          {"nodes", p.nodes},
-          {"springs", p.springs},
-          {"rel_l2_error", p.rel_l2_error},
-          {"reaction_force_rel_error", p.reaction_force_rel_error},
-          {"stable_dt_s", p.stable_dt_s},
-          {"steps_per_second", p.steps_per_second},
-          {"realtime_factor", p.realtime_factor},
-          {"dt_s", p.dt_s},
-          {"ms_per_60hz_frame", p.ms_per_60hz_frame},
-          {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
-          {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
-          {"not_resolved_by_reference", p.not_resolved_by_reference}};
 }
 
 std::optional<double> optional_number(const nlohmann::json& j) {
@@ -258,6 +235,28 @@ std::vector<SweepPoint> sweep_resolution(cases::CaseParameters p, int resolution
 
 }  // namespace
 
+nlohmann::json point_json(const SweepPoint& p) {
+  return {{"variant", p.variant},
+          {"volume_preservation", p.volume_preservation},
+          {"contact_refinement_edge_m", json_or_null(p.contact_edge_m)},
+          {"integrator", p.integrator},
+          {"stepper", p.stepper},
+          {"resolution", p.resolution},
+          {"surface_vertices", p.surface_vertices},
+          {"nodes", p.nodes},
+          {"springs", p.springs},
+          {"rel_l2_error", p.rel_l2_error},
+          {"reaction_force_rel_error", p.reaction_force_rel_error},
+          {"stable_dt_s", p.stable_dt_s},
+          {"steps_per_second", p.steps_per_second},
+          {"realtime_factor", p.realtime_factor},
+          {"dt_s", p.dt_s},
+          {"ms_per_60hz_frame", p.ms_per_60hz_frame},
+          {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
+          {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
+          {"not_resolved_by_reference", p.not_resolved_by_reference}};
+}
+
 SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
                       const std::filesystem::path& fem_cache_directory) {
   const std::vector<int> resolutions =
@@ -330,67 +329,6 @@ SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettin
   return result;
 }
 
-nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result) {
-  nlohmann::json list = nlohmann::json::array();
-  for (const auto& p : result.points)
-    list.push_back(point_json(p));
-  nlohmann::json failed = nlohmann::json::array();
-  for (const auto& [resolution, why] : result.failed_resolutions)
-    failed.push_back({{"resolution", resolution}, {"error", why}});
-  nlohmann::json failed_variants = nlohmann::json::array();
-  for (const auto& f : result.failed_variants)
-    failed_variants.push_back(
-        {{"resolution", f.resolution}, {"variant", f.model}, {"error", f.error}});
-  return {{"case", parameters.name},
-          {"git_revision", git_revision()},
-          {"machine", machine_description()},
-          {"units", {{"length", "m"}, {"time", "s"}}},
-          {"points", list},
-          {"failed_resolutions", failed},
-          {"failed_variants", failed_variants},
-          {"networks_at_own_resolution",
-           result.networks ? nlohmann::json{{"resolution", result.networks->resolution},
-                                            {"networks", result.networks->networks},
-                                            {"note", result.networks->note}}
-                           : nlohmann::json(nullptr)}};
-}
-
-std::string sweep_table(const std::vector<SweepPoint>& points) {
-  std::ostringstream out;
-  out << "| variant | integrator (stepper) | resolution | surface vertices | nodes | springs | "
-         "rel L2 | force err | FEM own err (L2 / force) | stable dt s | steps/s | realtime factor "
-         "| "
-         "ms/60 Hz frame |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  char row[512];
-  auto number = [](const std::optional<double>& x) {
-    char cell[32] = "-";
-    if (x) std::snprintf(cell, sizeof cell, "%.4f", *x);
-    return std::string(cell);
-  };
-  auto flag = [](const SweepPoint& p, const char* metric) {
-    const auto& list = p.not_resolved_by_reference;
-    return std::find(list.begin(), list.end(), metric) != list.end() ? " ‡" : "";
-  };
-  bool any_flag = false;
-  for (const auto& p : points) {
-    std::snprintf(row, sizeof row,
-                  "| %s | %s (%s) | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | "
-                  "%.3g | %.3f |\n",
-                  p.model().c_str(), p.integrator.c_str(), p.stepper.c_str(), p.resolution,
-                  p.surface_vertices, p.nodes, p.springs, p.rel_l2_error, flag(p, "rel_l2_error"),
-                  p.reaction_force_rel_error, flag(p, "reaction_force_rel_error"),
-                  number(p.fem_estimated_rel_l2_error).c_str(),
-                  number(p.fem_estimated_force_rel_error).c_str(), p.stable_dt_s,
-                  p.steps_per_second, p.realtime_factor, p.ms_per_60hz_frame);
-    out << row;
-    any_flag = any_flag || !p.not_resolved_by_reference.empty();
-  }
-  if (any_flag)
-    out << "\n‡ within 3x of the reference's own error: not resolved by this reference\n";
-  return out.str();
-}
-
 std::vector<VariantConvergence> convergence_by_variant(const std::vector<SweepPoint>& points) {
   std::vector<VariantConvergence> result;
   for (const auto& p : points) {
@@ -412,120 +350,10 @@ std::vector<VariantConvergence> convergence_by_variant(const std::vector<SweepPo
   return result;
 }
 
-std::string convergence_section(const std::vector<VariantConvergence>& convergence) {
-  std::ostringstream out;
-  out << "## Error against resolution\n\n| variant | rel L2 at surface vertices | observed order |"
-         "\n|---|---|---|\n";
-  std::string diverging;
-  char cell[64];
-  for (const auto& v : convergence) {
-    out << "| " << v.variant << " | ";
-    for (std::size_t i = 0; i < v.error_at_vertices.size(); ++i) {
-      std::snprintf(cell, sizeof cell, "%s%.4f @ %d", i ? ", " : "", v.error_at_vertices[i].second,
-                    v.error_at_vertices[i].first);
-      out << cell;
-    }
-    std::snprintf(cell, sizeof cell, "%.2f", v.observed_order.value_or(0.0));
-    out << " | " << (v.observed_order ? cell : "-") << " |\n";
-    if (v.observed_order && *v.observed_order < 0)
-      diverging += (diverging.empty() ? "" : ", ") + v.variant;
-  }
-  out << "\nObserved order p from e ∝ h^p, h ∝ N^(-1/2), between the coarsest and the finest "
-         "resolution. ";
-  if (!diverging.empty())
-    out << "**Not converging: " << diverging
-        << "** (the error grows as the model is refined: refining does not make this model "
-           "approach the FEM).";
-  out << "\n\n";
-  return out.str();
-}
-
 bool keeps_real_time(const SweepPoint& point, double rate_hz) {
   if (!(point.dt_s > 0) || !(point.steps_per_second > 0)) return false;
   const double steps_per_tick = std::ceil(1.0 / (rate_hz * point.dt_s) - 1e-9);
   return point.steps_per_second >= rate_hz * steps_per_tick;
-}
-
-namespace {
-
-std::string configuration(const SweepPoint& p) {
-  return p.model() + ", " + p.integrator + ", resolution " + std::to_string(p.resolution) + " (" +
-         std::to_string(p.nodes) + " nodes)";
-}
-
-bool flagged(const SweepPoint& p, const char* metric) {
-  const auto& list = p.not_resolved_by_reference;
-  return std::find(list.begin(), list.end(), metric) != list.end();
-}
-
-bool resolved(const SweepPoint& p) {
-  return p.not_resolved_by_reference.empty();
-}
-
-// A configuration whose error the reference does not resolve is named only with that said in its
-// own row: its error is within 3x of the FEM's own, so it may not be the least.
-std::string answer_row(const std::string& budget, const SweepPoint* p) {
-  if (!p) return "| " + budget + " | none of the swept configurations | | | |\n";
-  const std::string caveat =
-      resolved(*p) ? ""
-                   : " — **not resolved by this reference** (‡: within 3x of the FEM's own "
-                     "error; no resolved configuration meets this budget; a finer fem/cell size "
-                     "decides)";
-  char row[768];
-  std::snprintf(row, sizeof row, "| %s | %s%s | %.4f%s | %.4f%s | %.3g |\n", budget.c_str(),
-                configuration(*p).c_str(), caveat.c_str(), p->rel_l2_error,
-                flagged(*p, "rel_l2_error") ? " ‡" : "", p->reaction_force_rel_error,
-                flagged(*p, "reaction_force_rel_error") ? " ‡" : "", p->realtime_factor);
-  return row;
-}
-
-// The best point that `admits` among those the reference resolves; only where none is resolved,
-// the best of the others (answer_row says so).
-template <typename Admits, typename Better>
-const SweepPoint* best_point(const std::vector<SweepPoint>& points, Admits admits, Better better) {
-  const SweepPoint* best = nullptr;
-  for (bool only_resolved : {true, false}) {
-    for (const auto& p : points)
-      if (admits(p) && (!only_resolved || resolved(p)) && (!best || better(p, *best))) best = &p;
-    if (best) return best;
-  }
-  return nullptr;
-}
-
-}  // namespace
-
-std::string sweep_answer(const std::vector<SweepPoint>& points, std::optional<double> max_error) {
-  const auto less_error = [](const SweepPoint& a, const SweepPoint& b) {
-    return std::tie(a.rel_l2_error, a.reaction_force_rel_error) <
-           std::tie(b.rel_l2_error, b.reaction_force_rel_error);
-  };
-  auto least_error = [&](double rate) {
-    return best_point(
-        points, [&](const SweepPoint& p) { return keeps_real_time(p, rate); }, less_error);
-  };
-  std::ostringstream out;
-  out << "## Answer\n\n"
-         "| budget | configuration | rel L2 | force err | real-time factor |\n"
-         "|---|---|---|---|---|\n"
-      << answer_row("least error, 60 Hz visual loop in real time", least_error(60.0))
-      << answer_row("least error, 1 kHz haptic loop in real time", least_error(1000.0));
-  if (max_error) {
-    const SweepPoint* cheapest = best_point(
-        points, [&](const SweepPoint& p) { return p.rel_l2_error <= *max_error; },
-        [](const SweepPoint& a, const SweepPoint& b) {
-          return a.realtime_factor > b.realtime_factor;
-        });
-    char budget[96];
-    std::snprintf(budget, sizeof budget, "cheapest with rel L2 <= %g", *max_error);
-    out << answer_row(budget, cheapest);
-  }
-  out << "\nA loop of rate f keeps real time when each tick's ceil(1 / (f dt)) steps, at the step "
-         "dt the sweep timed (half the measured stable step), take at most 1/f s on this "
-         "machine. "
-      << (max_error ? "" : "`--max-error E` adds the cheapest configuration within rel L2 E. ")
-      << "Configurations the reference resolves are preferred. ‡: within 3x of the reference's "
-         "own error, so not resolved by this reference.\n\n";
-  return out.str();
 }
 
 }  // namespace msfem::compare

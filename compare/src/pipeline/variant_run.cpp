@@ -21,6 +21,7 @@
 #include "msfem/massspring/surface_geometry.hpp"
 #include "msfem/massspring/tool_contact.hpp"
 #include "msfem/massspring/topology_builders.hpp"
+#include "pipeline/builtin_variants.hpp"
 #include "pipeline/cholmod_factor.hpp"
 
 namespace msfem::compare {
@@ -33,67 +34,12 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-ms::SpringNetwork three_tier_network(const Problem& problem, const ms::Material& material) {
-  const auto& p = problem.parameters;
-  ms::ThreeTierOptions o;
-  o.inner_tiers = p.mass_spring.inner_tiers;
-  o.tier2_scale = p.mass_spring.middle_tier_scale;
-  o.tier3_scale = p.mass_spring.inner_tier_scale;
-  o.center = problem.centroid;  // the support's, which a refined surface's would miss
-  o.tier23_diagonals = p.mass_spring.inner_diagonals;
-  o.material = material;
-  return ms::build_three_tier(problem.surface.vertices, problem.surface.triangles, o);
-}
-
-ms::SpringNetwork single_layer_network(const Problem& problem, const ms::Material& material) {
-  ms::SingleLayerOptions o;
-  // Every node not supported is tied to its rest position (as simulators' rest-shape springs
-  // do; the supported ones are fixed, so their anchors do nothing). A bare membrane held only at
-  // some nodes, like the brain's base, has no transverse stiffness at rest: Newton failed on it.
-  o.anchor_to_rest = true;
-  o.material = material;
-  return ms::build_single_layer(problem.surface.vertices, problem.surface.triangles, o);
-}
-
-ms::SpringNetwork tet_edges_network(const Problem& problem, const fem_reference::VolumeMesh& mesh,
-                                    const ms::Material& material) {
-  ms::TetEdgesOptions o;
-  o.stiffness_rule = problem.parameters.mass_spring.stiffness_model;
-  o.material = material;
-  const Eigen::MatrixX4i tets = mesh.tetrahedra;
-  return ms::build_tet_edges(mesh.vertices, tets, o);
-}
-
-ms::SpringNetwork skeleton_network(const Problem& problem, const ms::Material& material) {
-  const auto& ms_p = problem.parameters.mass_spring;
-  const auto& s = problem.surface;
-  const int wanted = ms_p.skeleton_control_points > 0
-                         ? ms_p.skeleton_control_points
-                         : std::max(20, static_cast<int>(s.num_vertices() / 10));
-  const cases::Surface control = cases::simplify(s, std::min<int>(wanted, s.num_vertices()));
-  ms::SkeletonOptions o;
-  o.control_scale = ms_p.skeleton_draw_factor;
-  o.center = problem.centroid;
-  o.material = material;
-  return ms::build_skeleton(s.vertices, s.triangles, control.vertices, control.triangles, o);
-}
-
 ms::SpringNetwork build_network(cases::Variant variant, const Problem& problem,
                                 const fem_reference::VolumeMesh& mesh) {
   ms::Material material;
   material.youngs_modulus = problem.parameters.material.youngs_modulus_pa;
   material.density = problem.parameters.material.density_kg_per_m3;
-  switch (variant) {
-    case cases::Variant::three_tier:
-      return three_tier_network(problem, material);
-    case cases::Variant::single_layer:
-      return single_layer_network(problem, material);
-    case cases::Variant::tet_edges:
-      return tet_edges_network(problem, mesh, material);
-    case cases::Variant::skeleton:
-      return skeleton_network(problem, material);
-  }
-  throw std::logic_error("build_network: a variant without a builder");
+  return detail::builtin_variant(variant).network(problem, mesh, material);
 }
 
 std::string scientific(double value) {
@@ -122,7 +68,7 @@ ms::ModulusField youngs_modulus_field(const Problem& problem) {
 
 // The variants whose builders give the volume elements volume preservation acts on.
 bool has_volume_elements(cases::Variant variant) {
-  return variant == cases::Variant::three_tier || variant == cases::Variant::tet_edges;
+  return detail::builtin_variant(variant).volume_elements != nullptr;
 }
 
 // The volume elements of a variant that has them (three_tier's shell prisms, tet_edges'
@@ -136,12 +82,8 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
     if (group == volume_group) modulus *= factor;
   const auto& rest = model.network().rest_positions;
   if (!variant.spec.builtin || !has_volume_elements(*variant.spec.builtin)) return;
-  ms::VolumeElements elements;
-  if (variant.spec.builtin == cases::Variant::three_tier)
-    elements = ms::tier_prisms(rest, problem.surface.triangles,
-                               static_cast<int>(problem.surface.num_vertices()), 3, modulus);
-  else
-    elements = ms::tetrahedron_elements(rest, variant.tetrahedra, modulus);
+  ms::VolumeElements elements = detail::builtin_variant(*variant.spec.builtin)
+                                    .volume_elements(rest, problem, variant.tetrahedra, modulus);
   const int all = elements.num_elements();
   // The brain's offset inner tiers fold where the surface is concave: such prisms are inverted or
   // flat at rest, and with them Newton stalled (residual ~1e-7 N after 100 iterations).
@@ -158,20 +100,8 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
 
 }  // namespace
 
-const std::vector<std::string>& spring_groups_of(cases::Variant variant) {
-  static const std::map<cases::Variant, std::vector<std::string>> groups = {
-      {cases::Variant::three_tier,
-       {"tier1_edges", "tier2_edges", "tier12_diagonals", "tier12_radial", "tier23_radial"}},
-      {cases::Variant::single_layer, {"surface_edges"}},
-      {cases::Variant::tet_edges, {"tet_edges"}},
-      {cases::Variant::skeleton, {"surface_edges", "skeleton_edges", "links"}}};
-  return groups.at(variant);
-}
-
 std::vector<std::string> spring_groups_of(cases::Variant variant, const cases::CaseParameters& p) {
-  std::vector<std::string> groups = spring_groups_of(variant);
-  if (variant == cases::Variant::three_tier && p.mass_spring.inner_diagonals)
-    groups.emplace_back("tier23_diagonals");
+  std::vector<std::string> groups = detail::builtin_variant(variant).spring_groups(p);
   if (p.mass_spring.volume_preservation && has_volume_elements(variant))
     groups.emplace_back(volume_group);
   return groups;
@@ -278,12 +208,10 @@ void build_builtin(BuiltVariant& variant, cases::Variant kind, const Problem& pr
   if (problem.youngs_modulus_image)
     variant.youngs_modulus_range = ms::apply_modulus_field(network, youngs_modulus_field(problem),
                                                            p.material.youngs_modulus_pa);
-  if (kind == cases::Variant::tet_edges) variant.tetrahedra = mesh.tetrahedra;
-  if (problem.local_refinement) {
-    // three_tier copies the surface into its two inner tiers.
-    const int added = problem.local_refinement->added_vertices;
-    variant.refinement_added_nodes = kind == cases::Variant::three_tier ? 3 * added : added;
-  }
+  const detail::BuiltinVariant& row = detail::builtin_variant(kind);
+  if (row.on_fem_mesh) variant.tetrahedra = mesh.tetrahedra;
+  if (problem.local_refinement)
+    variant.refinement_added_nodes = row.surface_copies * problem.local_refinement->added_vertices;
   variant.warnings = network.warnings;
   variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
   ms::MassSpringModel& model = *variant.model;

@@ -21,7 +21,7 @@ SpringNetwork build_single_layer(const Eigen::MatrixX3d& vertices,
   const int nv = static_cast<int>(vertices.rows());
   SpringNetwork network;
   detail::add_nodes(network, vertices, "surface");
-  const int edges = add_springs(network, unique_edges(triangles), "surface_edges");
+  const int edges = add_springs(network, unique_edges(triangles), spring_groups(options)[0]);
 
   // A shell has no volume of its own: the enclosed volume sets the mass and, through the isotropic
   // network rule, the order of magnitude of the edge stiffness.
@@ -58,6 +58,10 @@ SpringNetwork build_single_layer(const Eigen::MatrixX3d& vertices,
   network.surface_triangles = triangles;
   network.validate();
   return network;
+}
+
+std::vector<std::string> spring_groups(const SingleLayerOptions&) {
+  return {"surface_edges"};
 }
 
 }  // namespace msfem::massspring

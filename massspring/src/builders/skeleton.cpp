@@ -40,17 +40,18 @@ SpringNetwork build_skeleton(const Eigen::MatrixX3d& vertices, const Eigen::Matr
   detail::add_nodes(network, vertices, "surface");
   detail::add_nodes(network, control, "skeleton");
 
-  const int surface_group = add_springs(network, unique_edges(triangles), "surface_edges");
+  const std::vector<std::string> names = spring_groups(options);  // surface, skeleton, links
+  const int surface_group = add_springs(network, unique_edges(triangles), names[0]);
   std::vector<std::array<int, 2>> skeleton_edges;
   for (const auto& [a, b] : unique_edges(control_triangles))
     skeleton_edges.push_back({nv + a, nv + b});
-  const int skeleton_group = add_springs(network, skeleton_edges, "skeleton_edges");
+  const int skeleton_group = add_springs(network, skeleton_edges, names[1]);
   std::vector<std::array<int, 2>> links;
   const auto nearest = nearest_points(control, vertices, options.links_per_vertex);
   for (int i = 0; i < nv; ++i)
     for (int c : nearest[i])
       links.push_back({i, nv + c});
-  const int link_group = add_springs(network, links, "links");
+  const int link_group = add_springs(network, links, names[2]);
 
   // Mass: half of ρV on the surface, half on the skeleton, each spread by vertex area.
   const double volume = std::abs(enclosed_volume(vertices, triangles));
@@ -73,6 +74,10 @@ SpringNetwork build_skeleton(const Eigen::MatrixX3d& vertices, const Eigen::Matr
   network.surface_triangles = triangles;
   network.validate();
   return network;
+}
+
+std::vector<std::string> spring_groups(const SkeletonOptions&) {
+  return {"surface_edges", "skeleton_edges", "links"};
 }
 
 }  // namespace msfem::massspring

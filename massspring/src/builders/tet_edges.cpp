@@ -78,7 +78,7 @@ SpringNetwork build_tet_edges(const Eigen::MatrixX3d& vertices, const Eigen::Mat
   std::vector<std::array<int, 2>> pairs;
   for (const auto& entry : edge_stiffness)
     pairs.push_back(entry.first);
-  add_springs(network, pairs, "tet_edges");
+  add_springs(network, pairs, spring_groups(options)[0]);
   int s = 0;
   for (const auto& entry : edge_stiffness)
     network.stiffness[s++] = entry.second;
@@ -104,6 +104,10 @@ SpringNetwork build_tet_edges(const Eigen::MatrixX3d& vertices, const Eigen::Mat
     if (on_surface[i]) network.surface_nodes.push_back(i);
   network.validate();
   return network;
+}
+
+std::vector<std::string> spring_groups(const TetEdgesOptions&) {
+  return {"tet_edges"};
 }
 
 }  // namespace msfem::massspring

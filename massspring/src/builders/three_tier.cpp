@@ -13,6 +13,14 @@
 namespace msfem::massspring {
 namespace {
 
+// The spring groups, named here once (spring_groups lists them for callers).
+constexpr const char* tier1_group = "tier1_edges";
+constexpr const char* tier2_group = "tier2_edges";
+constexpr const char* tier12_diagonal_group = "tier12_diagonals";
+constexpr const char* tier12_radial_group = "tier12_radial";
+constexpr const char* tier23_radial_group = "tier23_radial";
+constexpr const char* tier23_diagonal_group = "tier23_diagonals";
+
 void check_options(const ThreeTierOptions& options) {
   if (options.inner_tiers != InnerTierMethod::normal_offset) {
     if (!std::isfinite(options.tier2_scale) || !(options.tier2_scale > 1.0))
@@ -137,11 +145,11 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
     radial12.push_back({i, nv + i});
     radial23.push_back({nv + i, 2 * nv + i});
   }
-  const int g1 = add_springs(network, tier1_edges, "tier1_edges");
-  const int g2 = add_springs(network, tier2_edges, "tier2_edges");
-  const int g12 = add_springs(network, diagonals, "tier12_diagonals");
-  const int r12 = add_springs(network, radial12, "tier12_radial");
-  const int r23 = add_springs(network, radial23, "tier23_radial");
+  const int g1 = add_springs(network, tier1_edges, tier1_group);
+  const int g2 = add_springs(network, tier2_edges, tier2_group);
+  const int g12 = add_springs(network, diagonals, tier12_diagonal_group);
+  const int r12 = add_springs(network, radial12, tier12_radial_group);
+  const int r23 = add_springs(network, radial23, tier23_radial_group);
   std::vector<int> shell23_groups = {r23};
   if (options.tier23_diagonals) {
     std::vector<std::array<int, 2>> inner;
@@ -149,7 +157,7 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
       inner.push_back({nv + a, 2 * nv + b});
       inner.push_back({nv + b, 2 * nv + a});
     }
-    shell23_groups.push_back(add_springs(network, inner, "tier23_diagonals"));
+    shell23_groups.push_back(add_springs(network, inner, tier23_diagonal_group));
   }
 
   // Masses lumped from volume: half of each shell to each of its two tiers, by vertex area; the
@@ -195,6 +203,13 @@ SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::Ma
   network.surface_triangles = triangles;
   network.validate();
   return network;
+}
+
+std::vector<std::string> spring_groups(const ThreeTierOptions& options) {
+  std::vector<std::string> groups = {tier1_group, tier2_group, tier12_diagonal_group,
+                                     tier12_radial_group, tier23_radial_group};
+  if (options.tier23_diagonals) groups.emplace_back(tier23_diagonal_group);
+  return groups;
 }
 
 }  // namespace msfem::massspring

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "msfem/massspring/spring_network.hpp"
@@ -72,6 +73,9 @@ struct ThreeTierOptions {
 /// following the vertex areas at its ends (so a locally refined surface is not stiffer there).
 SpringNetwork build_three_tier(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& triangles,
                                const ThreeTierOptions& options = {});
+/// The spring groups build_three_tier gives with `options`, in its order: what a caller checks
+/// group names against before it builds (the builder names its groups from the same list).
+std::vector<std::string> spring_groups(const ThreeTierOptions& options);
 
 /// The triangles f whose prism between `outer` and `inner` (tier_prisms' nine tetrahedra, all
 /// three splits) has a tetrahedron whose volume does not have the orientation of a shell below an
@@ -92,6 +96,7 @@ struct SingleLayerOptions {
 SpringNetwork build_single_layer(const Eigen::MatrixX3d& vertices,
                                  const Eigen::MatrixX3i& triangles,
                                  const SingleLayerOptions& options = {});
+std::vector<std::string> spring_groups(const SingleLayerOptions& options);
 
 /// --- skeleton (pancreas seed) ---
 /// Control points = the vertices of a coarse control mesh (a simplification of the surface, made by
@@ -111,6 +116,7 @@ SpringNetwork build_skeleton(const Eigen::MatrixX3d& vertices, const Eigen::Matr
                              const Eigen::MatrixX3d& control_vertices,
                              const Eigen::MatrixX3i& control_triangles,
                              const SkeletonOptions& options = {});
+std::vector<std::string> spring_groups(const SkeletonOptions& options);
 
 /// --- tet_edges (volumetric baseline) ---
 /// A spring on every edge of a tetrahedral mesh (group "tet_edges"); masses ρ V_t / 4 per corner;
@@ -122,5 +128,6 @@ struct TetEdgesOptions {
 };
 SpringNetwork build_tet_edges(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX4i& tetrahedra,
                               const TetEdgesOptions& options = {});
+std::vector<std::string> spring_groups(const TetEdgesOptions& options);
 
 }  // namespace msfem::massspring

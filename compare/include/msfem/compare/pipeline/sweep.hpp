@@ -78,17 +78,12 @@ struct SweepResult {
 SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
                       const std::filesystem::path& fem_cache_directory);
 
-nlohmann::json sweep_json(const cases::CaseParameters& parameters, const SweepResult& result);
-std::string sweep_table(const std::vector<SweepPoint>& points);
+/// One point as sweep.json lists it and as the ranks pass it to each other.
+nlohmann::json point_json(const SweepPoint& point);
 
 /// Whether the point keeps a loop of `rate_hz` in real time at the step it was timed at: each
 /// tick of 1/rate s takes ceil(1 / (rate dt)) steps, which must fit in the tick.
 bool keeps_real_time(const SweepPoint& point, double rate_hz);
-
-/// The sweep's answer, markdown: for a 60 Hz visual loop and a 1 kHz haptic loop in real time,
-/// the least-error configuration that keeps it (rel L2, then force error); with `max_error`, the
-/// cheapest configuration (largest real-time factor) within that rel L2.
-std::string sweep_answer(const std::vector<SweepPoint>& points, std::optional<double> max_error);
 
 /// A variant's error at each swept resolution (the error does not depend on the integrator) and
 /// its observed order p, e ∝ h^p with h ∝ N^(-1/2) for N surface vertices, from the coarsest to
@@ -100,7 +95,5 @@ struct VariantConvergence {
   std::optional<double> observed_order;
 };
 std::vector<VariantConvergence> convergence_by_variant(const std::vector<SweepPoint>& points);
-/// The convergence as a markdown section, saying which variants do not converge.
-std::string convergence_section(const std::vector<VariantConvergence>& convergence);
 
 }  // namespace msfem::compare

@@ -16,12 +16,10 @@
 
 namespace msfem::compare {
 
-/// The spring groups each variant's builder makes (tests check the list against the built
-/// networks), for checking a case's names before anything is solved.
-const std::vector<std::string>& spring_groups_of(cases::Variant variant);
-/// The same as the case names them: with three_tier's `tier23_diagonals` (mass spring/three
-/// tier/inner diagonals) and, under mass spring/volume preservation, `volume` for the variants
-/// that have volume elements.
+/// The groups a variant's builder makes under the case's settings (the builder's own list, so
+/// with three_tier's `tier23_diagonals` under mass spring/three tier/inner diagonals) and, under
+/// mass spring/volume preservation, `volume` for the variants that have volume elements: for
+/// checking a case's names before anything is built or solved.
 std::vector<std::string> spring_groups_of(cases::Variant variant, const cases::CaseParameters& p);
 
 /// Throws cases::InputError naming the case file and key for a `mass spring/group scales` group
