@@ -18,9 +18,9 @@
 namespace msfem::compare {
 namespace {
 
-nlohmann::json variant_parameters(const massspring::MassSpringModel& model) {
+VariantParameters variant_parameters(const massspring::MassSpringModel& model) {
   const auto& n = model.network();
-  nlohmann::json groups = nlohmann::json::object();
+  VariantParameters parameters;
   for (std::size_t g = 0; g < n.spring_group_names.size(); ++g) {
     double k = 0, d = 0;
     int count = 0;
@@ -30,17 +30,15 @@ nlohmann::json variant_parameters(const massspring::MassSpringModel& model) {
         d += n.damping[i];
         ++count;
       }
-    groups[n.spring_group_names[g]] = {{"springs", count},
-                                       {"mean_stiffness_n_per_m", count ? k / count : 0.0},
-                                       {"mean_damping_n_s_per_m", count ? d / count : 0.0}};
+    parameters.spring_groups[n.spring_group_names[g]] = {count, count ? k / count : 0.0,
+                                                         count ? d / count : 0.0};
   }
-  nlohmann::json parameters = {{"spring_groups", groups},
-                               {"total_mass_kg", n.masses.sum()},
-                               {"anchors", n.num_anchors()},
-                               {"constrained_nodes", model.constrained_nodes().size()}};
+  parameters.total_mass_kg = n.masses.sum();
+  parameters.anchors = n.num_anchors();
+  parameters.constrained_nodes = static_cast<int>(model.constrained_nodes().size());
   if (const auto& volume = model.volume())
-    parameters["volume_preservation"] = {{"elements", volume->elements().num_elements()},
-                                         {"mean_modulus_pa", volume->elements().modulus.mean()}};
+    parameters.volume_preservation = VariantParameters::Volume{volume->elements().num_elements(),
+                                                               volume->elements().modulus.mean()};
   return parameters;
 }
 
@@ -204,8 +202,8 @@ VariantResult variant_header(const BuiltVariant& built) {
   r.refinement_added_nodes = built.refinement_added_nodes;
   r.warnings = built.warnings;
   r.parameters = variant_parameters(*built.model);
-  r.parameters["youngs_modulus_range_pa"] = {built.youngs_modulus_range.min,
-                                             built.youngs_modulus_range.max};
+  r.parameters.youngs_modulus_min_pa = built.youngs_modulus_range.min;
+  r.parameters.youngs_modulus_max_pa = built.youngs_modulus_range.max;
   return r;
 }
 

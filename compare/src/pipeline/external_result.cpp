@@ -198,10 +198,8 @@ std::vector<VariantResult> external_variants(const CaseRun& run) {
     v.external = true;
     v.nodes = static_cast<int>(run.problem.surface.num_vertices());
     v.timing.stepper = "external";
-    nlohmann::json files = nlohmann::json::array();
     for (const auto& f : r.files)
-      files.push_back(f.string());
-    v.parameters = {{"external", files}};
+      v.parameters.external_files.push_back(f.string());
     // A run at the first tool only (a sweep) takes the first file.
     for (std::size_t k = 0; k < run.loads.size(); ++k) {
       ExternalAnswer a = read_external_answer(r.files.at(k), run.problem, where);

@@ -74,7 +74,7 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   pt.variant = v.name;
   pt.integrator = massspring::to_string(integrator);
   pt.stepper = t.stepper;
-  pt.volume_preservation = v.parameters.contains("volume_preservation");
+  pt.volume_preservation = v.parameters.volume_preservation.has_value();
   if (run.problem.local_refinement) pt.contact_edge_m = run.problem.local_refinement->edge_m;
   pt.resolution = resolution;
   pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
@@ -210,7 +210,7 @@ std::vector<SweepPoint> sweep_resolution(cases::CaseParameters p, int resolution
     failed.push_back({resolution, SweepPoint::model_name(name, volume, edge), why});
   std::vector<std::pair<std::size_t, massspring::IntegratorKind>> items;
   for (std::size_t v = 0; v < run.variants.size(); ++v)
-    if (!volume || run.variants[v].parameters.contains("volume_preservation"))
+    if (!volume || run.variants[v].parameters.volume_preservation)
       for (const auto& integrator : settings.integrators)
         items.emplace_back(v, integrator);
   std::vector<SweepPoint> points(items.size());

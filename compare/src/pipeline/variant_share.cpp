@@ -130,6 +130,31 @@ void timing_fields(Io& io, T& t) {
   io.io(t.settle_time_s), io.io(t.settled), io.io(t.ms_per_60hz_frame);
 }
 
+template <typename Io, typename P>
+void parameter_fields(Io& io, P& p) {  // VariantParameters
+  long long n = static_cast<long long>(p.spring_groups.size());
+  io.io(n);
+  std::vector<std::pair<std::string, VariantParameters::SpringGroup>> groups(
+      p.spring_groups.begin(), p.spring_groups.end());
+  groups.resize(static_cast<std::size_t>(n));
+  for (auto& [name, g] : groups)
+    io.io(name), io.io(g.springs), io.io(g.mean_stiffness_n_per_m), io.io(g.mean_damping_n_s_per_m);
+  p.spring_groups = {groups.begin(), groups.end()};
+  io.io(p.total_mass_kg), io.io(p.anchors), io.io(p.constrained_nodes);
+  bool volume = p.volume_preservation.has_value();
+  io.io(volume);
+  if (volume) {
+    if (!p.volume_preservation) p.volume_preservation.emplace();
+    io.io(p.volume_preservation->elements), io.io(p.volume_preservation->mean_modulus_pa);
+  }
+  io.io(p.youngs_modulus_min_pa), io.io(p.youngs_modulus_max_pa);
+  n = static_cast<long long>(p.external_files.size());
+  io.io(n);
+  p.external_files.resize(static_cast<std::size_t>(n));
+  for (auto& f : p.external_files)
+    io.io(f);
+}
+
 template <typename Io, typename S>
 void share_fields(Io& io, S& s) {
   io.io(s.variant), io.io(s.timed), io.io(s.tetrahedra), io.io(s.failure_order), io.io(s.failure);
@@ -141,9 +166,7 @@ void share_fields(Io& io, S& s) {
   r.spec.network = network;
   io.io(r.name), io.io(r.nodes), io.io(r.springs), io.io(r.refinement_added_nodes);
   timing_fields(io, r.timing);
-  std::string parameters = r.parameters.dump();
-  io.io(parameters);
-  if constexpr (std::is_same_v<Io, Reader>) r.parameters = nlohmann::json::parse(parameters);
+  parameter_fields(io, r.parameters);
   long long n = static_cast<long long>(r.warnings.size());
   io.io(n);
   r.warnings.resize(static_cast<std::size_t>(n));

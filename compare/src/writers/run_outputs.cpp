@@ -227,10 +227,9 @@ std::string youngs_modulus_text(const CaseRun& run) {
                      image->table().describe() + "): FEM " + fmt("%.4g", st.youngs_modulus_min) +
                      "-" + fmt("%.4g", st.youngs_modulus_max) + " Pa at its quadrature points";
   for (const auto& v : run.variants)
-    if (const auto range = v.parameters.find("youngs_modulus_range_pa");
-        range != v.parameters.end())
-      text += ", " + v.name + " " + fmt("%.4g", (*range)[0].get<double>()) + "-" +
-              fmt("%.4g", (*range)[1].get<double>()) + " Pa";
+    if (!v.external)
+      text += ", " + v.name + " " + fmt("%.4g", v.parameters.youngs_modulus_min_pa) + "-" +
+              fmt("%.4g", v.parameters.youngs_modulus_max_pa) + " Pa";
   return text;
 }
 
@@ -257,11 +256,9 @@ std::string report_markdown(const CaseRun& run, const Plots& plots) {
   // Variants of the same name differ with and without it: say which tables are which.
   std::string with_volume;
   for (const auto& v : run.variants)
-    if (v.parameters.contains("volume_preservation"))
-      with_volume +=
-          (with_volume.empty() ? "" : ", ") + v.name + " (mean κ " +
-          std::to_string(v.parameters["volume_preservation"]["mean_modulus_pa"].get<double>()) +
-          " Pa)";
+    if (const auto& volume = v.parameters.volume_preservation)
+      with_volume += (with_volume.empty() ? "" : ", ") + v.name + " (mean κ " +
+                     std::to_string(volume->mean_modulus_pa) + " Pa)";
   md << "- volume preservation: " << (with_volume.empty() ? "off" : with_volume) << "\n\n";
   for (const auto& n : run.problem.notes)
     md << "> note: " << n << "\n";

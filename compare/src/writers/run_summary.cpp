@@ -218,6 +218,25 @@ nlohmann::json fem_json(const CaseRun& run) {
 }
 
 // One variant: its errors, force, timing, force-depth curve, and (with more tools) per load.
+nlohmann::json parameters_json(const VariantParameters& p) {
+  if (!p.external_files.empty()) return {{"external", p.external_files}};
+  nlohmann::json groups = nlohmann::json::object();
+  for (const auto& [name, g] : p.spring_groups)
+    groups[name] = {{"springs", g.springs},
+                    {"mean_stiffness_n_per_m", g.mean_stiffness_n_per_m},
+                    {"mean_damping_n_s_per_m", g.mean_damping_n_s_per_m}};
+  nlohmann::json j = {
+      {"spring_groups", groups},
+      {"total_mass_kg", p.total_mass_kg},
+      {"anchors", p.anchors},
+      {"constrained_nodes", p.constrained_nodes},
+      {"youngs_modulus_range_pa", {p.youngs_modulus_min_pa, p.youngs_modulus_max_pa}}};
+  if (p.volume_preservation)
+    j["volume_preservation"] = {{"elements", p.volume_preservation->elements},
+                                {"mean_modulus_pa", p.volume_preservation->mean_modulus_pa}};
+  return j;
+}
+
 nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
   const ToolLoadVariant& first = v.loads.front();
   const nlohmann::json fd = curve_json(first.force_depth);
@@ -258,7 +277,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
        json_or_null(force_depth_exponent(first.force_depth, run.loads.front().tool))},
       {"inverted_elements", json_or_null(first.inverted_elements)},
       {"warnings", v.warnings},
-      {"parameters", v.parameters}};
+      {"parameters", parameters_json(v.parameters)}};
   if (run.loads.size() > 1) j["loads"] = variant_loads(run, v);
   return j;
 }

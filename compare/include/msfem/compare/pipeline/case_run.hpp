@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -48,6 +49,26 @@ struct ToolLoadVariant {
   Eigen::MatrixX3d error;                 ///< model − FEM at the surface vertices, m
 };
 
+/// What a variant was built with (summary.json's "parameters"): its spring groups as used, its
+/// mass and supports, its volume preservation and the E its springs saw; an outside simulator's
+/// answer has its files only.
+struct VariantParameters {
+  struct SpringGroup {
+    int springs = 0;
+    double mean_stiffness_n_per_m = 0.0, mean_damping_n_s_per_m = 0.0;
+  };
+  std::map<std::string, SpringGroup> spring_groups;
+  double total_mass_kg = 0.0;
+  int anchors = 0, constrained_nodes = 0;
+  struct Volume {
+    int elements = 0;
+    double mean_modulus_pa = 0.0;
+  };
+  std::optional<Volume> volume_preservation;  ///< none: built without it
+  double youngs_modulus_min_pa = 0.0, youngs_modulus_max_pa = 0.0;
+  std::vector<std::string> external_files;  ///< an outside simulator's answer's (nothing else)
+};
+
 /// One variant over the run: what it is, how fast it runs, and its result at every load.
 struct VariantResult {
   VariantSpec spec;
@@ -55,7 +76,7 @@ struct VariantResult {
   int nodes = 0, springs = 0;
   std::optional<int> refinement_added_nodes;  ///< BuiltVariant's
   Timing timing;                              ///< from its equilibrium at the first load
-  nlohmann::json parameters;                  ///< group stiffness, damping, masses as used
+  VariantParameters parameters;
   std::vector<std::string> warnings;
   std::vector<ToolLoadVariant> loads;  ///< one per CaseRun::loads, in that order
   /// An outside simulator's answer (mass spring/results): no network, nothing timed here.
