@@ -85,7 +85,7 @@ TEST(SweepAnswer, ObservedOrderPerVariantAndTheVariantsThatDoNotConverge) {
 // only where no resolved one meets the budget, and then its row says so in words.
 TEST(SweepAnswer, AResolvedConfigurationIsPreferredAndAnUnresolvedOneIsSaidToBe) {
   SweepPoint unresolved = point("coarse", 1e-4, 50000, 0.35);
-  unresolved.not_resolved_by_reference = {"rel_l2_error"};
+  unresolved.not_resolved_by_reference = {Metric::rel_l2_error};
   const SweepPoint resolved = point("fine", 1e-4, 50000, 0.50);
   const std::string answer = sweep_answer({unresolved, resolved}, std::nullopt);
   const auto at = answer.find("| least error, 1 kHz");

@@ -185,8 +185,8 @@ void warn_at_load(const CaseRun& run, long long tetrahedra, std::size_t load, Va
   }
   if (load != 0) return;
   std::string unresolved;
-  for (const std::string& metric : unresolved_metrics(run, result, load))
-    unresolved += (unresolved.empty() ? "" : ", ") + metric;
+  for (const Metric metric : unresolved_metrics(run, result, load))
+    unresolved += (unresolved.empty() ? "" : ", ") + std::string(metric_name(metric));
   if (!unresolved.empty())
     r.warnings.push_back("not resolved by this reference: " + unresolved +
                          " within 3x of the FEM's own estimated error (a finer fem/cell "
@@ -456,19 +456,19 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   return run;
 }
 
-std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
-                                            std::size_t load) {
-  std::vector<std::string> metrics;
+std::vector<Metric> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
+                                       std::size_t load) {
+  std::vector<Metric> metrics;
   if (load >= run.loads.size()) return metrics;
   const LoadErrorEstimate& estimate = run.loads[load].fem_error;
   if (within_reference_error(variant.errors.all.rel_l2_error, estimate.rel_l2_error))
-    metrics.emplace_back("rel_l2_error");
+    metrics.push_back(Metric::rel_l2_error);
   if (run.loads[load].tool &&
       within_reference_error(variant.reaction_force_rel_error, estimate.force_rel_error))
-    metrics.emplace_back("reaction_force_rel_error");
+    metrics.push_back(Metric::reaction_force_rel_error);
   if (variant.patch_displacement_rel_error &&
       within_reference_error(*variant.patch_displacement_rel_error, estimate.force_rel_error))
-    metrics.emplace_back("patch_displacement_rel_error");
+    metrics.push_back(Metric::patch_displacement_rel_error);
   return metrics;
 }
 

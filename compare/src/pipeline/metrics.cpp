@@ -1,10 +1,52 @@
 #include "msfem/compare/pipeline/metrics.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace msfem::compare {
+
+const char* metric_name(Metric metric) {
+  switch (metric) {
+    case Metric::rel_l2_error:
+      return "rel_l2_error";
+    case Metric::max_error_m:
+      return "max_error_m";
+    case Metric::reaction_force_rel_error:
+      return "reaction_force_rel_error";
+    case Metric::patch_displacement_rel_error:
+      return "patch_displacement_rel_error";
+    case Metric::volume_change:
+      return "volume_change";
+  }
+  return "?";
+}
+
+std::vector<std::string> metric_names(const std::vector<Metric>& metrics) {
+  std::vector<std::string> names;
+  for (const Metric m : metrics)
+    names.emplace_back(metric_name(m));
+  return names;
+}
+
+std::vector<Metric> metrics_named(const std::vector<std::string>& names) {
+  const Metric all[] = {Metric::rel_l2_error, Metric::max_error_m, Metric::reaction_force_rel_error,
+                        Metric::patch_displacement_rel_error, Metric::volume_change};
+  std::vector<Metric> metrics;
+  for (const std::string& name : names) {
+    const auto* m = std::find_if(std::begin(all), std::end(all),
+                                 [&](Metric a) { return name == metric_name(a); });
+    if (m == std::end(all)) throw std::invalid_argument("no metric named '" + name + "'");
+    metrics.push_back(*m);
+  }
+  return metrics;
+}
+
+bool contains(const std::vector<Metric>& metrics, Metric metric) {
+  return std::find(metrics.begin(), metrics.end(), metric) != metrics.end();
+}
 
 ErrorMetrics displacement_error(const Eigen::MatrixX3d& u, const Eigen::MatrixX3d& v,
                                 const std::vector<int>& rows) {

@@ -22,12 +22,20 @@ constexpr double metric_abs_tol = 1e-9, metric_rel_tol = 1e-3;
 constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the largest |u|
 
 // The baseline holds each variant at the run's first load.
-double metric_value(const ToolLoadVariant& v, const std::string& metric) {
-  if (metric == "rel_l2_error") return v.errors.all.rel_l2_error;
-  if (metric == "max_error_m") return v.errors.all.max_error_m;
-  if (metric == "reaction_force_rel_error")
-    return v.force_measured ? v.reaction_force_rel_error : std::nan("");
-  return v.volume_change;
+double metric_value(const ToolLoadVariant& v, Metric metric) {
+  switch (metric) {
+    case Metric::rel_l2_error:
+      return v.errors.all.rel_l2_error;
+    case Metric::max_error_m:
+      return v.errors.all.max_error_m;
+    case Metric::reaction_force_rel_error:
+      return v.force_measured ? v.reaction_force_rel_error : std::nan("");
+    case Metric::patch_displacement_rel_error:
+      return v.patch_displacement_rel_error.value_or(std::nan(""));
+    case Metric::volume_change:
+      return v.volume_change;
+  }
+  return std::nan("");
 }
 
 std::string number(double x) {
@@ -40,24 +48,24 @@ bool finite(const nlohmann::json& j) {
   return j.is_number() && std::isfinite(j.get<double>());
 }
 
-void compare_metric(const std::string& case_name, const ToolLoadVariant& v,
-                    const std::string& metric, const nlohmann::json& base,
-                    std::vector<RegressionRow>& rows) {
-  RegressionRow row{case_name, v.name, metric, "-", number(metric_value(v, metric)), "-", "ok"};
+void compare_metric(const std::string& case_name, const ToolLoadVariant& v, Metric metric,
+                    const nlohmann::json& base, std::vector<RegressionRow>& rows) {
+  const std::string name = metric_name(metric);
+  RegressionRow row{case_name, v.name, name, "-", number(metric_value(v, metric)), "-", "ok"};
   const double now = metric_value(v, metric);
-  if (!base.contains(metric)) {
+  if (!base.contains(name)) {
     row.status = "MISSING";
     rows.push_back(row);
     return;
   }
-  const auto& b = base.at(metric);
+  const auto& b = base.at(name);
   if (!finite(b.value("value", nlohmann::json())) || !std::isfinite(now)) {
     row.status = "NON-FINITE";
     rows.push_back(row);
     return;
   }
   const double value = b.at("value"), abs_tol = b.at("abs_tol"), rel_tol = b.at("rel_tol");
-  const bool magnitude = metric == "volume_change";
+  const bool magnitude = metric == Metric::volume_change;
   const double base_v = magnitude ? std::abs(value) : value,
                now_v = magnitude ? std::abs(now) : now;
   const double tol = abs_tol + rel_tol * std::abs(value);
@@ -121,10 +129,11 @@ std::string reference_hash(const CaseRun& run) {
 
 }  // namespace
 
-const std::vector<std::string>& regression_metrics() {
-  static const std::vector<std::string> names = {"rel_l2_error", "max_error_m",
-                                                 "reaction_force_rel_error", "volume_change"};
-  return names;
+const std::vector<Metric>& regression_metrics() {
+  static const std::vector<Metric> metrics = {Metric::rel_l2_error, Metric::max_error_m,
+                                              Metric::reaction_force_rel_error,
+                                              Metric::volume_change};
+  return metrics;
 }
 
 std::string file_hash(const std::filesystem::path& file) {
@@ -152,9 +161,9 @@ nlohmann::json write_baseline(const CaseRun& run, const std::filesystem::path& d
     nlohmann::json metrics = nlohmann::json::object();
     for (const auto& m : regression_metrics())
       if (std::isfinite(metric_value(v.loads.front(), m)))  // an outside answer without a force
-        metrics[m] = {{"value", metric_value(v.loads.front(), m)},
-                      {"abs_tol", metric_abs_tol},
-                      {"rel_tol", metric_rel_tol}};
+        metrics[metric_name(m)] = {{"value", metric_value(v.loads.front(), m)},
+                                   {"abs_tol", metric_abs_tol},
+                                   {"rel_tol", metric_rel_tol}};
     variants[v.name] = {{"metrics", metrics},
                         {"field",
                          {{"dataset", "/variants/" + v.name + "/displacement"},
@@ -218,7 +227,7 @@ std::vector<RegressionRow> compare_with_baseline(const CaseRun& run, const nlohm
     const auto& metrics = variants.at(v.name).at("metrics");
     for (const auto& m : regression_metrics())
       // An outside answer without a force has no force error, here or in its baseline.
-      if (metrics.contains(m) || std::isfinite(metric_value(v.loads.front(), m)))
+      if (metrics.contains(metric_name(m)) || std::isfinite(metric_value(v.loads.front(), m)))
         compare_metric(p.name, v.loads.front(), m, metrics, rows);
     compare_field(p.name, v.loads.front(), variants.at(v.name),
                   directory / base.value("fields_file", ""), rows);

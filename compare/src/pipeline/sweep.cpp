@@ -119,7 +119,8 @@ SweepPoint point_from_json(const nlohmann::json& j) {
     j.at(key).get_to(*to);
   p.fem_estimated_rel_l2_error = optional_number(j.at("fem_estimated_rel_l2_error"));
   p.fem_estimated_force_rel_error = optional_number(j.at("fem_estimated_force_rel_error"));
-  j.at("not_resolved_by_reference").get_to(p.not_resolved_by_reference);
+  p.not_resolved_by_reference =
+      metrics_named(j.at("not_resolved_by_reference").get<std::vector<std::string>>());
   return p;
 }
 
@@ -254,7 +255,7 @@ nlohmann::json point_json(const SweepPoint& p) {
           {"ms_per_60hz_frame", p.ms_per_60hz_frame},
           {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
           {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
-          {"not_resolved_by_reference", p.not_resolved_by_reference}};
+          {"not_resolved_by_reference", metric_names(p.not_resolved_by_reference)}};
 }
 
 SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,

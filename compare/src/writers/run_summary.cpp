@@ -84,7 +84,7 @@ nlohmann::json refinement_json(const Problem& problem) {
 nlohmann::json load_json(const CaseRun& run, std::size_t load, const ToolLoadVariant& o) {
   const ZonedErrorMetrics& e = o.errors;
   return {{"tool", load},
-          {"not_resolved_by_reference", unresolved_metrics(run, o, load)},
+          {"not_resolved_by_reference", metric_names(unresolved_metrics(run, o, load))},
           {"rel_l2_error", e.all.rel_l2_error},
           {"rms_error_m", e.all.rms_error_m},
           {"max_error_m", e.all.max_error_m},
@@ -258,7 +258,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"volume_change", first.volume_change},
       {"patch_mean_displacement_m", optional_vec(first.patch_mean_displacement)},
       {"patch_displacement_rel_error", json_or_null(first.patch_displacement_rel_error)},
-      {"not_resolved_by_reference", unresolved_metrics(run, first, 0)},
+      {"not_resolved_by_reference", metric_names(unresolved_metrics(run, first, 0))},
       {"integrator", v.timing.integrator},
       {"stepper", v.timing.stepper},
       {"dt_s", v.timing.dt_s},
@@ -335,10 +335,6 @@ std::string error_cell(double error, bool unresolved) {
   return cell;
 }
 
-bool contains(const std::vector<std::string>& list, const std::string& item) {
-  return std::find(list.begin(), list.end(), item) != list.end();
-}
-
 // Below the table: the reference's own error, and the patch comparison of a patch-force load.
 std::string table_notes(const CaseRun& run) {
   std::ostringstream out;
@@ -369,12 +365,12 @@ std::string table_notes(const CaseRun& run) {
     out << line;
     for (const auto& v : run.variants) {
       const ToolLoadVariant& own = v.loads.front();
-      std::snprintf(
-          line, sizeof line, "; %s %.3f mm (err %s)", v.name.c_str(),
-          1e3 * own.patch_mean_displacement->norm(),
-          error_cell(*own.patch_displacement_rel_error,
-                     contains(unresolved_metrics(run, own, 0), "patch_displacement_rel_error"))
-              .c_str());
+      std::snprintf(line, sizeof line, "; %s %.3f mm (err %s)", v.name.c_str(),
+                    1e3 * own.patch_mean_displacement->norm(),
+                    error_cell(*own.patch_displacement_rel_error,
+                               contains(unresolved_metrics(run, own, 0),
+                                        Metric::patch_displacement_rel_error))
+                        .c_str());
       out << line;
     }
     out << "\n";
@@ -422,7 +418,7 @@ std::string variant_table(const CaseRun& run) {
       std::snprintf(frame, sizeof frame, "%.3f", v.timing.ms_per_60hz_frame);
     }
     const ToolLoadVariant& own = v.loads.front();
-    const std::vector<std::string> unresolved = unresolved_metrics(run, own, 0);
+    const std::vector<Metric> unresolved = unresolved_metrics(run, own, 0);
     std::string force_error = "-";
     if (tool && !own.force_measured) {
       // An outside answer without a force: empty, never a zero.
@@ -432,12 +428,12 @@ std::string variant_table(const CaseRun& run) {
     } else if (tool) {
       std::snprintf(force, sizeof force, "%.4g", own.tool_force.norm());
       force_error = error_cell(own.reaction_force_rel_error,
-                               contains(unresolved, "reaction_force_rel_error"));
+                               contains(unresolved, Metric::reaction_force_rel_error));
     }
     std::snprintf(
         line, sizeof line, "| %-12s | %6d | %7s | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
         v.name.c_str(), v.nodes, springs,
-        error_cell(own.errors.all.rel_l2_error, contains(unresolved, "rel_l2_error")).c_str(),
+        error_cell(own.errors.all.rel_l2_error, contains(unresolved, Metric::rel_l2_error)).c_str(),
         1e3 * own.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
     out << line;
   }

@@ -50,9 +50,8 @@ std::string sweep_table(const std::vector<SweepPoint>& points) {
     if (x) std::snprintf(cell, sizeof cell, "%.4f", *x);
     return std::string(cell);
   };
-  auto flag = [](const SweepPoint& p, const char* metric) {
-    const auto& list = p.not_resolved_by_reference;
-    return std::find(list.begin(), list.end(), metric) != list.end() ? " ‡" : "";
+  auto flag = [](const SweepPoint& p, Metric metric) {
+    return contains(p.not_resolved_by_reference, metric) ? " ‡" : "";
   };
   bool any_flag = false;
   for (const auto& p : points) {
@@ -60,8 +59,9 @@ std::string sweep_table(const std::vector<SweepPoint>& points) {
                   "| %s | %s (%s) | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | "
                   "%.3g | %.3f |\n",
                   p.model().c_str(), p.integrator.c_str(), p.stepper.c_str(), p.resolution,
-                  p.surface_vertices, p.nodes, p.springs, p.rel_l2_error, flag(p, "rel_l2_error"),
-                  p.reaction_force_rel_error, flag(p, "reaction_force_rel_error"),
+                  p.surface_vertices, p.nodes, p.springs, p.rel_l2_error,
+                  flag(p, Metric::rel_l2_error), p.reaction_force_rel_error,
+                  flag(p, Metric::reaction_force_rel_error),
                   number(p.fem_estimated_rel_l2_error).c_str(),
                   number(p.fem_estimated_force_rel_error).c_str(), p.stable_dt_s,
                   p.steps_per_second, p.realtime_factor, p.ms_per_60hz_frame);
@@ -108,9 +108,8 @@ std::string configuration(const SweepPoint& p) {
          std::to_string(p.nodes) + " nodes)";
 }
 
-bool flagged(const SweepPoint& p, const char* metric) {
-  const auto& list = p.not_resolved_by_reference;
-  return std::find(list.begin(), list.end(), metric) != list.end();
+bool flagged(const SweepPoint& p, Metric metric) {
+  return contains(p.not_resolved_by_reference, metric);
 }
 
 bool resolved(const SweepPoint& p) {
@@ -129,8 +128,8 @@ std::string answer_row(const std::string& budget, const SweepPoint* p) {
   char row[768];
   std::snprintf(row, sizeof row, "| %s | %s%s | %.4f%s | %.4f%s | %.3g |\n", budget.c_str(),
                 configuration(*p).c_str(), caveat.c_str(), p->rel_l2_error,
-                flagged(*p, "rel_l2_error") ? " ‡" : "", p->reaction_force_rel_error,
-                flagged(*p, "reaction_force_rel_error") ? " ‡" : "", p->realtime_factor);
+                flagged(*p, Metric::rel_l2_error) ? " ‡" : "", p->reaction_force_rel_error,
+                flagged(*p, Metric::reaction_force_rel_error) ? " ‡" : "", p->realtime_factor);
   return row;
 }
 

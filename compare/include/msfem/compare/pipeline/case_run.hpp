@@ -146,10 +146,10 @@ std::vector<double> loading_path(std::vector<double> depths, double case_depth, 
 /// untouched, an equilibrium with no force.
 double path_step_of(const cases::ToolParameters& tool);
 
-/// The metrics (summary.json names) of `variant` at load `load` that lie within 3x the reference's
-/// own estimated error there: the reference does not resolve the variant's error in them.
-std::vector<std::string> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
-                                            std::size_t load);
+/// The metrics of `variant` at load `load` that lie within 3x the reference's own estimated error
+/// there: the reference does not resolve the variant's error in them.
+std::vector<Metric> unresolved_metrics(const CaseRun& run, const ToolLoadVariant& variant,
+                                       std::size_t load);
 
 /// The exponent n of the power law F = c d^n fitted (least squares in log-log) to the curve's
 /// force along the tool's outward normal: 1.5 for Hertz, 1 for a linear spring. None without a

@@ -3,9 +3,27 @@
 // docs/harness.md ("Metrics"): over the surface vertices not prescribed by a support or load.
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 namespace msfem::compare {
+
+/// The numbers about a variant at a load that other code names: summary.json's keys, the
+/// regression baselines' metrics and the "not resolved by this reference" flags.
+enum class Metric {
+  rel_l2_error,
+  max_error_m,
+  reaction_force_rel_error,
+  patch_displacement_rel_error,
+  volume_change
+};
+/// Its key in summary.json and the baselines.
+const char* metric_name(Metric metric);
+/// The names of `metrics`, in their order (summary.json's lists), and back; metrics_named throws
+/// std::invalid_argument naming an unknown name.
+std::vector<std::string> metric_names(const std::vector<Metric>& metrics);
+std::vector<Metric> metrics_named(const std::vector<std::string>& names);
+bool contains(const std::vector<Metric>& metrics, Metric metric);
 
 struct ErrorMetrics {
   double rel_l2_error = 0.0;              ///< ‖u − v‖₂ / ‖v‖₂

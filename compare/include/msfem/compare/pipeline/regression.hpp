@@ -14,7 +14,7 @@
 namespace msfem::compare {
 
 /// The metrics compared, each "worse" when it grows (volume_change: when its magnitude grows).
-const std::vector<std::string>& regression_metrics();
+const std::vector<Metric>& regression_metrics();
 
 /// Writes a run's baseline into `directory`: `<case>.json` (header: format version, case and mesh
 /// hashes, units, degree, git revision, date; per variant the metrics and the field's tolerances)

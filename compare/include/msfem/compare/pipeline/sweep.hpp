@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "msfem/cases/case_parameters.hpp"
+#include "msfem/compare/pipeline/metrics.hpp"
 
 namespace msfem::compare {
 
@@ -48,7 +49,7 @@ struct SweepPoint {
   /// The resolution's FEM reference's own error (fem/error estimate; none where not estimated)
   /// and the variant's metrics within 3x of it.
   std::optional<double> fem_estimated_rel_l2_error, fem_estimated_force_rel_error;
-  std::vector<std::string> not_resolved_by_reference;
+  std::vector<Metric> not_resolved_by_reference;
 };
 
 struct SweepResult {
