@@ -151,6 +151,38 @@ TEST(CliMpi, EveryVariantIsTimedOnTwoRanksWithTheOneRankStableStep) {
   }
 }
 
+// msfem sweep on two ranks: the timed items are dealt out and every rank gets every point back,
+// so rank 0 writes the one-rank sweep (its errors to the FEM's tolerance, its stable steps
+// bisected alike), each point once and in order.
+TEST(CliMpi, SweepOnTwoRanksListsTheOneRankPoints) {
+  const std::string mpirun = find_mpirun();
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not on PATH";
+  TemporaryDirectory one, two;
+  const std::string sweep = "sweep " + std::string(MSFEM_TEST_DATA_DIR) +
+                            "/small_sphere.prm --quiet --resolutions 1,2 "
+                            "--integrators symplectic_euler,implicit_euler --out ";
+  const auto alone = run_msfem(sweep + (one / "sweep").string());
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const auto shared = run_msfem_on_two_ranks(mpirun, sweep + (two / "sweep").string());
+  ASSERT_EQ(shared.exit_code, 0) << shared.err;
+  const auto a = nlohmann::json::parse(read_text(one / "sweep" / "sweep.json"))["points"];
+  const auto b = nlohmann::json::parse(read_text(two / "sweep" / "sweep.json"))["points"];
+  ASSERT_EQ(a.size(), 16u);  // 4 variants x 2 integrators x 2 resolutions
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string where = "point " + std::to_string(i);
+    for (const char* key : {"variant", "integrator", "stepper", "not_resolved_by_reference"})
+      EXPECT_EQ(a[i][key], b[i][key]) << where << " " << key;
+    for (const char* key : {"resolution", "surface_vertices", "nodes", "springs"})
+      EXPECT_EQ(a[i][key], b[i][key]) << where << " " << key;
+    for (const char* key : {"rel_l2_error", "reaction_force_rel_error", "stable_dt_s"})
+      EXPECT_NEAR(b[i][key].get<double>(), a[i][key].get<double>(),
+                  1e-6 * std::abs(a[i][key].get<double>()))
+          << where << " " << key;
+    EXPECT_GT(b[i]["steps_per_second"].get<double>(), 0.0) << where;
+  }
+}
+
 // msfem calibrate on two ranks: each rank solves its share of the loads at every evaluation, and
 // the fit is the one-rank fit (the FEM references agree to the solver's tolerance, and a handful
 // of evaluations keeps the optimiser on the same path).

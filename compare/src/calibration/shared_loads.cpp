@@ -2,36 +2,20 @@
 #include "calibration/shared_loads.hpp"
 
 #include <algorithm>
-#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <tuple>
 
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
+#include "pipeline/byte_packing.hpp"
 
 namespace msfem::compare {
 namespace {
 
-nlohmann::json errors_json(std::size_t i, const LoadErrors& e) {
-  return {{"i", i},
-          {"load", e.load},
-          {"rel_l2", e.rel_l2_error},
-          {"mean", e.mean_error_over_max_disp},
-          {"force_error", e.reaction_force_rel_error},
-          {"force", {e.tool_force.x(), e.tool_force.y(), e.tool_force.z()}},
-          {"patch", e.tool_patch_nodes}};
-}
-
-LoadErrors errors_from_json(const nlohmann::json& j) {
-  LoadErrors e;
-  j.at("load").get_to(e.load);
-  j.at("rel_l2").get_to(e.rel_l2_error);
-  j.at("mean").get_to(e.mean_error_over_max_disp);
-  j.at("force_error").get_to(e.reaction_force_rel_error);
-  for (int c = 0; c < 3; ++c)
-    e.tool_force[c] = j.at("force").at(c).get<double>();
-  j.at("patch").get_to(e.tool_patch_nodes);
-  return e;
+template <typename Io, typename E>
+void error_fields(Io& io, E& e) {  // LoadErrors
+  io.io(e.load), io.io(e.rel_l2_error), io.io(e.mean_error_over_max_disp);
+  io.io(e.reaction_force_rel_error), io.io(e.tool_force), io.io(e.tool_patch_nodes);
 }
 
 }  // namespace
@@ -48,27 +32,39 @@ std::vector<LoadErrors> shared_errors(std::size_t loads,
       errors[i] = one(i);
     return errors;
   }
-  nlohmann::json own = nlohmann::json::array();
+  // Each owned load: its index, whether it failed, then its errors or the failure.
+  detail::Writer own;
   for (std::size_t i = 0; i < loads; ++i) {
     if (!owns_load(i)) continue;
+    long long index = static_cast<long long>(i);
     try {
-      own.push_back(errors_json(i, one(i)));
+      LoadErrors e = one(i);
+      char failed = 0;
+      own.io(index), own.io(failed), error_fields(own, e);
     } catch (const std::exception& e) {
-      const bool input = dynamic_cast<const cases::InputError*>(&e) != nullptr;
-      own.push_back({{"i", i}, {"failure", e.what()}, {"input", input}});
+      char failed = 1, input = dynamic_cast<const cases::InputError*>(&e) != nullptr;
+      own.io(index), own.io(failed), own.io(std::string(e.what())), own.io(input);
       break;
     }
   }
   std::vector<std::tuple<std::size_t, std::string, bool>> failures;
-  for (const nlohmann::json& part : ranks::gather_json_on_all(own))
-    for (const auto& entry : part) {
-      const auto i = entry.at("i").get<std::size_t>();
-      if (entry.contains("failure"))
-        failures.emplace_back(i, entry.at("failure").get<std::string>(),
-                              entry.at("input").get<bool>());
-      else
-        errors[i] = errors_from_json(entry);
+  for (const std::string& part : ranks::gather_on_all(own.p.bytes())) {
+    detail::Reader from{detail::Unpacker(part)};
+    while (!from.u.done()) {
+      long long index = 0;
+      char failed = 0;
+      from.io(index), from.io(failed);
+      const auto i = static_cast<std::size_t>(index);
+      if (!failed) {
+        error_fields(from, errors.at(i));
+        continue;
+      }
+      std::string what;
+      char input = 0;
+      from.io(what), from.io(input);
+      failures.emplace_back(i, what, input != 0);
     }
+  }
   if (failures.empty()) return errors;
   const auto& [load, what, input] = *std::min_element(failures.begin(), failures.end());
   if (input) throw cases::InputError(what);
@@ -78,18 +74,21 @@ std::vector<LoadErrors> shared_errors(std::size_t loads,
 // Every load's last equilibrium on every rank, from the rank that solved it.
 std::vector<Eigen::VectorXd> shared_equilibria(const std::vector<Eigen::VectorXd>& mine) {
   if (ranks::count() == 1) return mine;
-  nlohmann::json own = nlohmann::json::array();
+  detail::Writer own;
   for (std::size_t i = 0; i < mine.size(); ++i)
-    if (owns_load(i))
-      own.push_back(
-          {{"i", i}, {"x", std::vector<double>(mine[i].data(), mine[i].data() + mine[i].size())}});
-  std::vector<Eigen::VectorXd> x(mine.size());
-  for (const nlohmann::json& part : ranks::gather_json_on_all(own))
-    for (const auto& entry : part) {
-      const auto values = entry.at("x").get<std::vector<double>>();
-      x[entry.at("i").get<std::size_t>()] = Eigen::Map<const Eigen::VectorXd>(
-          values.data(), static_cast<Eigen::Index>(values.size()));
+    if (owns_load(i)) {
+      long long index = static_cast<long long>(i);
+      own.io(index), own.io(mine[i]);
     }
+  std::vector<Eigen::VectorXd> x(mine.size());
+  for (const std::string& part : ranks::gather_on_all(own.p.bytes())) {
+    detail::Reader from{detail::Unpacker(part)};
+    while (!from.u.done()) {
+      long long index = 0;
+      from.io(index);
+      from.io(x.at(static_cast<std::size_t>(index)));
+    }
+  }
   return x;
 }
 

@@ -31,19 +31,6 @@ std::vector<std::string> metric_names(const std::vector<Metric>& metrics) {
   return names;
 }
 
-std::vector<Metric> metrics_named(const std::vector<std::string>& names) {
-  const Metric all[] = {Metric::rel_l2_error, Metric::max_error_m, Metric::reaction_force_rel_error,
-                        Metric::patch_displacement_rel_error, Metric::volume_change};
-  std::vector<Metric> metrics;
-  for (const std::string& name : names) {
-    const auto* m = std::find_if(std::begin(all), std::end(all),
-                                 [&](Metric a) { return name == metric_name(a); });
-    if (m == std::end(all)) throw std::invalid_argument("no metric named '" + name + "'");
-    metrics.push_back(*m);
-  }
-  return metrics;
-}
-
 bool contains(const std::vector<Metric>& metrics, Metric metric) {
   return std::find(metrics.begin(), metrics.end(), metric) != metrics.end();
 }

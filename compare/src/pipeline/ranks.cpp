@@ -191,14 +191,6 @@ std::vector<std::string> gather_on_all(const std::string& bytes) {
   return all_gather(bytes);
 }
 
-std::vector<nlohmann::json> gather_json_on_all(const nlohmann::json& value) {
-  const std::vector<std::uint8_t> bytes = nlohmann::json::to_cbor(value);
-  std::vector<nlohmann::json> all;
-  for (const std::string& part : gather_on_all(std::string(bytes.begin(), bytes.end())))
-    all.push_back(nlohmann::json::from_cbor(part));
-  return all;
-}
-
 std::string broadcast_from_root(const std::string& bytes) {
   if (count() == 1) return bytes;
   unsigned long long size = bytes.size();

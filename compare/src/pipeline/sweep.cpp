@@ -15,6 +15,7 @@
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/compare/writers/json_values.hpp"
+#include "pipeline/byte_packing.hpp"
 
 namespace msfem::compare {
 
@@ -93,45 +94,33 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   return pt;
 }
 
-std::optional<double> optional_number(const nlohmann::json& j) {
-  return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
-}
-
-SweepPoint point_from_json(const nlohmann::json& j) {
-  SweepPoint p;
-  j.at("variant").get_to(p.variant);
-  j.at("volume_preservation").get_to(p.volume_preservation);
-  p.contact_edge_m = optional_number(j.at("contact_refinement_edge_m"));
-  j.at("integrator").get_to(p.integrator);
-  j.at("stepper").get_to(p.stepper);
-  for (auto [key, to] : {std::pair{"resolution", &p.resolution},
-                         {"surface_vertices", &p.surface_vertices},
-                         {"nodes", &p.nodes},
-                         {"springs", &p.springs}})
-    j.at(key).get_to(*to);
-  for (auto [key, to] : {std::pair{"rel_l2_error", &p.rel_l2_error},
-                         {"reaction_force_rel_error", &p.reaction_force_rel_error},
-                         {"stable_dt_s", &p.stable_dt_s},
-                         {"steps_per_second", &p.steps_per_second},
-                         {"realtime_factor", &p.realtime_factor},
-                         {"dt_s", &p.dt_s},
-                         {"ms_per_60hz_frame", &p.ms_per_60hz_frame}})
-    j.at(key).get_to(*to);
-  p.fem_estimated_rel_l2_error = optional_number(j.at("fem_estimated_rel_l2_error"));
-  p.fem_estimated_force_rel_error = optional_number(j.at("fem_estimated_force_rel_error"));
-  p.not_resolved_by_reference =
-      metrics_named(j.at("not_resolved_by_reference").get<std::vector<std::string>>());
-  return p;
+template <typename Io, typename P>
+void point_fields(Io& io, P& p) {  // SweepPoint
+  io.io(p.variant), io.io(p.integrator), io.io(p.stepper), io.io(p.volume_preservation);
+  io.io(p.contact_edge_m), io.io(p.resolution), io.io(p.surface_vertices), io.io(p.nodes);
+  io.io(p.springs), io.io(p.rel_l2_error), io.io(p.reaction_force_rel_error);
+  io.io(p.stable_dt_s), io.io(p.steps_per_second), io.io(p.realtime_factor), io.io(p.dt_s);
+  io.io(p.ms_per_60hz_frame), io.io(p.fem_estimated_rel_l2_error);
+  io.io(p.fem_estimated_force_rel_error), io.io(p.not_resolved_by_reference);
 }
 
 // Under mpirun each rank timed the items it owns; every rank gets all of them, in item order.
 void share_points(std::vector<SweepPoint>& points, const std::vector<bool>& mine) {
-  nlohmann::json own = nlohmann::json::array();
+  detail::Writer own;
   for (std::size_t j = 0; j < points.size(); ++j)
-    if (mine[j]) own.push_back({{"item", j}, {"point", point_json(points[j])}});
-  for (const nlohmann::json& part : ranks::gather_json_on_all(own))
-    for (const auto& entry : part)
-      points[entry.at("item").get<std::size_t>()] = point_from_json(entry.at("point"));
+    if (mine[j]) {
+      long long item = static_cast<long long>(j);
+      own.io(item);
+      point_fields(own, points[j]);
+    }
+  for (const std::string& part : ranks::gather_on_all(own.p.bytes())) {
+    detail::Reader from{detail::Unpacker(part)};
+    while (!from.u.done()) {
+      long long item = 0;
+      from.io(item);
+      point_fields(from, points.at(static_cast<std::size_t>(item)));
+    }
+  }
 }
 
 // Which rank times each (variant, integrator) item. A timing costs about the model's nodes times

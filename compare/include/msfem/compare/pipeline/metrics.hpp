@@ -19,10 +19,8 @@ enum class Metric {
 };
 /// Its key in summary.json and the baselines.
 const char* metric_name(Metric metric);
-/// The names of `metrics`, in their order (summary.json's lists), and back; metrics_named throws
-/// std::invalid_argument naming an unknown name.
+/// The names of `metrics`, in their order (summary.json's lists).
 std::vector<std::string> metric_names(const std::vector<Metric>& metrics);
-std::vector<Metric> metrics_named(const std::vector<std::string>& names);
 bool contains(const std::vector<Metric>& metrics, Metric metric);
 
 struct ErrorMetrics {

@@ -5,7 +5,6 @@
 // function here sees one rank.
 
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -47,9 +46,6 @@ void agree(const std::function<void()>& work);
 
 /// Every rank's `bytes` on every rank, in rank order.
 std::vector<std::string> gather_on_all(const std::string& bytes);
-
-/// Every rank's `value` on every rank, in rank order (sent as CBOR).
-std::vector<nlohmann::json> gather_json_on_all(const nlohmann::json& value);
 
 /// Rank 0's `bytes` on every rank.
 std::string broadcast_from_root(const std::string& bytes);
