@@ -162,6 +162,25 @@ TEST(Calibration, FitsTheCoefficientGroupOfAFieldWrittenOutsideMassspring) {
   EXPECT_NEAR(linear.groups[0].fitted_stiffness_n_per_m / 40.0, 1.0, 0.01);
 }
 
+// A group two of the model's fields name is refused before any solve: a fit could not tell which
+// to scale.
+TEST(Calibration, RefusesAGroupTwoFieldsName) {
+  const Problem problem = make_problem(sphere_case());
+  const auto refs = synthetic_references(problem);
+  BuiltVariant base = build_variant(cases::Variant::three_tier, problem, {}, refs.front().tool);
+  for (int copy = 0; copy < 2; ++copy)
+    base.model->add_field(std::make_shared<massspring::testing::Grasper>(
+        base.model->num_nodes(), std::vector<int>{0}, Eigen::Vector3d::Zero(), 1.0, 0.0));
+  CalibrationOptions options;
+  options.groups = {"grasp"};
+  try {
+    calibrate(problem, base, refs, {}, options);
+    FAIL() << "a group two fields name was accepted";
+  } catch (const cases::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'grasp' 2 times"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Calibration, TheVolumeGroupNeedsVolumePreservation) {
   const Problem problem = make_problem(sphere_case());
   const auto refs = synthetic_references(problem);
