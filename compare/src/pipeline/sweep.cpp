@@ -14,7 +14,6 @@
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
-#include "msfem/compare/writers/json_values.hpp"
 #include "pipeline/byte_packing.hpp"
 
 namespace msfem::compare {
@@ -224,28 +223,6 @@ std::vector<SweepPoint> sweep_resolution(cases::CaseParameters p, int resolution
 }
 
 }  // namespace
-
-nlohmann::json point_json(const SweepPoint& p) {
-  return {{"variant", p.variant},
-          {"volume_preservation", p.volume_preservation},
-          {"contact_refinement_edge_m", json_or_null(p.contact_edge_m)},
-          {"integrator", p.integrator},
-          {"stepper", p.stepper},
-          {"resolution", p.resolution},
-          {"surface_vertices", p.surface_vertices},
-          {"nodes", p.nodes},
-          {"springs", p.springs},
-          {"rel_l2_error", p.rel_l2_error},
-          {"reaction_force_rel_error", p.reaction_force_rel_error},
-          {"stable_dt_s", p.stable_dt_s},
-          {"steps_per_second", p.steps_per_second},
-          {"realtime_factor", p.realtime_factor},
-          {"dt_s", p.dt_s},
-          {"ms_per_60hz_frame", p.ms_per_60hz_frame},
-          {"fem_estimated_rel_l2_error", json_or_null(p.fem_estimated_rel_l2_error)},
-          {"fem_estimated_force_rel_error", json_or_null(p.fem_estimated_force_rel_error)},
-          {"not_resolved_by_reference", metric_names(p.not_resolved_by_reference)}};
-}
 
 SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
                       const std::filesystem::path& fem_cache_directory) {

@@ -79,9 +79,6 @@ struct SweepResult {
 SweepResult run_sweep(const cases::CaseParameters& parameters, const SweepSettings& settings,
                       const std::filesystem::path& fem_cache_directory);
 
-/// One point as sweep.json lists it and as the ranks pass it to each other.
-nlohmann::json point_json(const SweepPoint& point);
-
 /// Whether the point keeps a loop of `rate_hz` in real time at the step it was timed at: each
 /// tick of 1/rate s takes ceil(1 / (rate dt)) steps, which must fit in the tick.
 bool keeps_real_time(const SweepPoint& point, double rate_hz);
