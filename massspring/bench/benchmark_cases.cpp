@@ -1,5 +1,6 @@
 #include "msfem/massspring_bench/benchmark_cases.hpp"
 
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 
 #include <cmath>

@@ -10,6 +10,7 @@
 
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 #include "msfem/massspring_bench/benchmark_cases.hpp"

@@ -8,6 +8,7 @@
 
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
 
 namespace msfem::massspring {
@@ -250,7 +251,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
   result.explicit_last_step_threads = fast.last_step_threads();
   if (options.run_other_integrators)
     time_other_integrators(model, start, fast_options, options, result);
-  const bool fields = !model.fields().empty();
+  const bool fields = model.has_added_fields();
   if (fields)
     result.notes.push_back(
         "naive not run: the naive loop steps springs only; the fast steppers share the force "

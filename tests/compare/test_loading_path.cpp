@@ -4,6 +4,7 @@
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/topology_builders.hpp"
 
 namespace msfem::compare {

@@ -8,6 +8,7 @@
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring_bench/benchmark_cases.hpp"
 
 namespace msfem::compare {

@@ -8,6 +8,7 @@
 
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/linearised_statics.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/modal_damping.hpp"
 
 namespace msfem::massspring {

@@ -6,6 +6,7 @@
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/topology_builders.hpp"
 #include "msfem/massspring_bench/stepping_benchmark.hpp"

@@ -104,8 +104,8 @@ TEST(ForceFields, AFieldJoinsEveryForceModelCall) {
   const MassSpringModel springs_only = model;
   const double k = 40.0, c = 0.3;
   model.set_field<RestTether>(std::make_shared<RestTether>(rest, k, c));
-  ASSERT_EQ(model.fields().size(), 1u);
-  EXPECT_EQ(model.field_names(), "tether");
+  ASSERT_EQ(model.fields().size(), 2u);
+  EXPECT_EQ(model.field_names(), "springs, tether");
 
   const Eigen::VectorXd extra = model.force(x, v) - springs_only.force(x, v);
   EXPECT_LT((extra + k * (x - rest) + c * v).norm(), 1e-9 * (k * (x - rest)).norm());
@@ -139,7 +139,8 @@ TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByType) {
       tier_prisms(model.network().rest_positions, model.network().surface_triangles,
                   static_cast<int>(nv.size()), 3, 500.0)));
   model.set_field<RestTether>(tether->scaled("tether", 3.0));
-  ASSERT_EQ(model.field_names(), "tether, volume preservation");  // replaced where it was
+  ASSERT_EQ(model.field_names(),
+            "springs, tether, volume preservation");  // replaced where it was
   const MassSpringModel with_volume_only = [&] {
     MassSpringModel m = model;
     m.clear_fields<RestTether>();
@@ -150,13 +151,46 @@ TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByType) {
   EXPECT_THROW(tether->scaled("volume", 2.0), ModelError);
   EXPECT_THROW(model.add_field(std::make_shared<RestTether>(rest.head(6), 1.0, 0.0)), ModelError);
   // Copies share fields but not the list: clearing one copy's leaves the other's.
-  EXPECT_EQ(springs_only.fields().size(), 0u);
+  EXPECT_EQ(springs_only.fields().size(), 1u);
   EXPECT_NE(model.volume(), nullptr);
 }
 
 // The fast steppers step a model's fields as the generic integrators do (a tether with a dashpot:
 // it reads x and v): symplectic Euler on the explicit kernels, backward Euler on the implicit ones
 // with the tether's Jacobians. The linearised statics give each field its own weight.
+// The springs are the model's first field, over the model's own network: a copy's springs read
+// the copy's parameters, and the list refuses to lose or replace them.
+TEST(ForceFields, SpringsAreTheModelsFirstFieldOverItsOwnNetwork) {
+  const MassSpringModel model = three_tier_model();
+  const Eigen::VectorXd rest = model.rest_state();
+  const Eigen::VectorXd x = perturbed(rest, 0.002, 3), v = perturbed(0 * rest, 0.01, 4);
+  ASSERT_EQ(model.field_index<SpringForceField>(), 0);
+  EXPECT_EQ(&model.find_field<SpringForceField>()->network(), &model.network());
+  const Eigen::VectorXd before = model.force(x, v);
+
+  MassSpringModel stiffer = model;
+  EXPECT_EQ(&stiffer.springs().network(), &stiffer.network());
+  stiffer.scale_group_stiffness(stiffer.network().spring_group_names[0], 2.0);
+  EXPECT_EQ(model.force(x, v), before);  // the original's springs are untouched
+  EXPECT_GT((stiffer.force(x, v) - before).norm(), 1e-6 * before.norm());
+
+  MassSpringModel assigned = three_tier_model();
+  assigned = stiffer;
+  EXPECT_EQ(&assigned.springs().network(), &assigned.network());
+  EXPECT_EQ(assigned.force(x, v), stiffer.force(x, v));
+
+  // The sum over the fields is the springs' force plus the loads when nothing else is added.
+  Eigen::VectorXd springs_only = Eigen::VectorXd::Zero(rest.size());
+  model.springs().add_force(x, v, springs_only);
+  for (int i = 0; i < model.num_nodes(); ++i)
+    springs_only.segment<3>(3 * i) += model.node_load(i);
+  EXPECT_LT((springs_only - before).norm(), 1e-14 * before.norm());
+
+  stiffer.clear_fields<ForceField>();
+  EXPECT_EQ(stiffer.fields().size(), 1u);
+  EXPECT_THROW(stiffer.replace_field(0, std::make_shared<RestTether>(rest, 1.0, 0.0)), ModelError);
+}
+
 TEST(ForceFields, FastSteppersStepFieldsAndLinearStaticsWeighEach) {
   MassSpringModel model = tethered_model();
   const Eigen::VectorXd rest = model.rest_state();

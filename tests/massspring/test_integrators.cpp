@@ -10,6 +10,7 @@
 #include "icosphere.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/topology_builders.hpp"
 

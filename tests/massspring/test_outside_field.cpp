@@ -83,6 +83,7 @@ TEST(OutsideField, EveryFieldAnswersASolversCallsAsTheWholeCalls) {
                                 tier_prisms(net.rest_positions, net.surface_triangles,
                                             static_cast<int>(net.surface_nodes.size()), 3, 500.0));
   const std::vector<std::pair<const char*, const ForceField*>> fields = {
+      {"springs", &model.springs()},
       {"grasper", g.grasper.get()},
       {"node contact", &nodes},
       {"surface contact", &surface},

@@ -7,6 +7,7 @@
 
 #include "icosphere.hpp"
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/static_solver.hpp"
 #include "msfem/massspring/tool_contact.hpp"

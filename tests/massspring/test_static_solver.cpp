@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "icosphere.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/static_solver.hpp"
 #include "msfem/massspring/tool_contact.hpp"
 #include "msfem/massspring/topology_builders.hpp"

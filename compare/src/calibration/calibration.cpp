@@ -17,6 +17,7 @@
 #include "msfem/compare/pipeline/metrics.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/linearised_statics.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "pipeline/cholmod_factor.hpp"
 
 namespace msfem::compare {
@@ -271,6 +272,7 @@ class GroupFit {
     for (int g = 0; g < n_; ++g)
       weights[g + 1] = std::exp(theta[g]);
     for (std::size_t f = 0; f < base_.model->fields().size(); ++f) {
+      if (base_.model->fields()[f].get() == &base_.model->springs()) continue;  // the parts above
       double weight = 1.0;
       for (int g = 0; g < n_; ++g)
         if (field_of_[g] == static_cast<int>(f)) weight = factor_at(theta, g);

@@ -13,6 +13,7 @@
 #include "msfem/compare/pipeline/fem_references.hpp"
 #include "msfem/compare/pipeline/fem_run.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 
 namespace msfem::compare {
 namespace {

@@ -10,8 +10,9 @@
 #include "msfem/compare/calibration/calibration_case.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/writers/calibration_outputs.hpp"
 
 namespace msfem::compare {
 namespace {

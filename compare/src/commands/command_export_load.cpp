@@ -11,9 +11,9 @@
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/external_result.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/vtu.hpp"
 #include "msfem/massspring/surface_geometry.hpp"
 

@@ -11,9 +11,10 @@
 #include "msfem/cases/network_file.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/fem_run.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 
 namespace msfem::compare {

@@ -8,9 +8,9 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/haptic.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/haptic_outputs.hpp"
 
 namespace msfem::compare {

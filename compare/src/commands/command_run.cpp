@@ -9,9 +9,9 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/case_run.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
 #include "msfem/compare/writers/run_outputs.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 

@@ -13,6 +13,7 @@
 #include "msfem/compare/pipeline/fem_cache.hpp"
 #include "msfem/compare/pipeline/ranks.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "variant_share.hpp"
 
 namespace msfem::compare {

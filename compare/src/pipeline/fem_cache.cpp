@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "msfem/cases/setting_names.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/content_hash.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
-#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/pipeline/json_values.hpp"
 
 namespace msfem::compare {
 namespace {

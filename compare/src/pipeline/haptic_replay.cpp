@@ -16,9 +16,10 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/compare/pipeline/haptic.hpp"
 #include "msfem/compare/pipeline/progress.hpp"
-#include "msfem/compare/pipeline/variant_stepper.hpp"
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/modal_damping.hpp"
+#include "msfem/massspring/stepper.hpp"
 
 namespace msfem::compare {
 namespace {
@@ -193,7 +194,7 @@ void haptic_loop(Shared& shared, const ToolPath& path, const HapticSettings& set
 // The model loop: steps to keep up with the wall clock (never more than half a millisecond's
 // worth per batch, so that the tool moves with the device), then hands over a local model.
 void model_loop(Shared& shared, BuiltVariant& variant, ms::ToolContact& contact,
-                VariantStepper& stepper, double dt, const cases::CaseParameters& parameters,
+                ms::Stepper& stepper, double dt, const cases::CaseParameters& parameters,
                 const std::vector<ParameterChange>& changes, HapticReplay& out) {
   ms::MassSpringModel& model = *variant.model;
   const double max_lag_s = 0.02;  // a model this far behind drops the debt: it runs slow motion
@@ -222,7 +223,7 @@ void model_loop(Shared& shared, BuiltVariant& variant, ms::ToolContact& contact,
     const int batch_cap = std::max(1, static_cast<int>(5e-4 / step_s));
     const int count = std::clamp(static_cast<int>(debt / dt), 1, batch_cap);
     const auto batch_start = Clock::now();
-    stepper.advance(dt, count);
+    stepper.step(dt, count);
     const double batch_s = seconds_since(batch_start);
     busy_s += batch_s;
     step_s = batch_s / count;
@@ -331,9 +332,9 @@ HapticReplay replay_once(BuiltVariant& variant, const cases::CaseParameters& par
   model.set_field<ms::ToolContact>(contact);
   const int cores = static_cast<int>(std::max(2u, std::thread::hardware_concurrency()));
   out.model_threads = settings.model_threads > 0 ? settings.model_threads : std::min(2, cores - 1);
-  VariantStepper stepper(model, parameters.timing.integrator, ms::initial_state(model),
-                         out.model_threads);
-  out.stepper = stepper.name();
+  const auto stepper = ms::make_stepper(model, parameters.timing.integrator,
+                                        ms::initial_state(model), {out.model_threads});
+  out.stepper = stepper->name();
 
   Shared shared;
   shared.device.store(path.at(path.start()));
@@ -350,7 +351,7 @@ HapticReplay replay_once(BuiltVariant& variant, const cases::CaseParameters& par
     }
   });
   try {
-    model_loop(shared, variant, *contact, stepper, dt, parameters, changes, out);
+    model_loop(shared, variant, *contact, *stepper, dt, parameters, changes, out);
   } catch (...) {
     shared.failure = std::current_exception();
     shared.stop.store(true);

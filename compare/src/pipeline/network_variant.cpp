@@ -12,6 +12,7 @@
 #include "msfem/cases/network_file.hpp"
 #include "msfem/cases/surface.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/modal_damping.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 

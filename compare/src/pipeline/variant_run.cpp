@@ -14,6 +14,7 @@
 #include "msfem/fem_reference/supports_and_loads.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/modal_damping.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/static_solver.hpp"

@@ -8,12 +8,11 @@
 
 #include "msfem/compare/pipeline/progress.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
-#include "msfem/compare/pipeline/variant_stepper.hpp"
 #include "msfem/massspring/errors.hpp"
-#include "msfem/massspring/fast_implicit_stepper.hpp"
-#include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
+#include "msfem/massspring/stepper.hpp"
 #include "msfem/massspring_bench/stepping_benchmark.hpp"
 
 namespace msfem::compare {
@@ -37,24 +36,24 @@ void stable_step(Timing& t, const ms::MassSpringModel& model, ms::IntegratorKind
 // Steps per second as msfem bench takes them (massspring::rate_spread: the median of five samples
 // after a warm-up, explicit steps ten per call), samples of a tenth of a second and at least a
 // fifth of the case's timing/steps each.
-double median_rate(VariantStepper& stepper, double dt, int steps) {
+double median_rate(ms::Stepper& stepper, double dt, int steps) {
   ms::SteppingBenchmarkOptions options;
   options.seconds_per_sample = 0.1;
   options.min_steps_per_sample = std::max(1, steps / options.samples);
-  return ms::rate_spread([&](int n) { stepper.advance(dt, n); },
-                         stepper.explicit_steps() ? options.steps_per_call : 1, options)
+  return ms::rate_spread([&](int n) { stepper.step(dt, n); },
+                         stepper.batches_steps() ? options.steps_per_call : 1, options)
       .median;
 }
 
 // Wall time from rest, with the load applied, to within 1 % of the static equilibrium's travel.
-void settle(Timing& t, VariantStepper& stepper, const BuiltVariant& variant,
+void settle(Timing& t, ms::Stepper& stepper, const BuiltVariant& variant,
             const Eigen::VectorXd& x_rest, const Eigen::VectorXd& equilibrium) {
   const double travel = (equilibrium - x_rest).norm();
   const int stride = 20;
   const double wall_limit_s = 20.0;
   const auto start = Clock::now();
   while (seconds_since(start) < wall_limit_s) {
-    stepper.advance(t.dt_s, stride);
+    stepper.step(t.dt_s, stride);
     const ms::State s = stepper.state();
     if (!s.x.allFinite())
       throw ms::DivergenceError("variant " + variant.name + " diverged while settling at dt " +
@@ -70,48 +69,6 @@ void settle(Timing& t, VariantStepper& stepper, const BuiltVariant& variant,
 }
 
 }  // namespace
-
-VariantStepper::VariantStepper(const ms::MassSpringModel& model, ms::IntegratorKind kind,
-                               const ms::State& start, int threads) {
-  if (kind == ms::IntegratorKind::implicit_euler) {
-    ms::FastImplicitOptions options;
-    if (threads > 0) options.threads = std::min(options.threads, threads);
-    implicit_ = std::make_unique<ms::FastImplicitStepper>(model, options);
-    implicit_->set_state(start);
-    return;
-  }
-  ms::FastStepperOptions options;
-  if (threads > 0) options.threads = std::min(options.threads, threads);
-  options.integrator =
-      kind == ms::IntegratorKind::central_difference ? ms::IntegratorKind::symplectic_euler : kind;
-  explicit_ = std::make_unique<ms::FastExplicitStepper>(model, options);
-  explicit_->set_state(start);
-}
-
-VariantStepper::~VariantStepper() = default;
-
-void VariantStepper::advance(double dt, int count) {
-  if (explicit_) return explicit_->step(dt, count);
-  for (int i = 0; i < count; ++i)
-    implicit_->step(dt);
-}
-
-ms::State VariantStepper::state() const {
-  return explicit_ ? explicit_->state() : implicit_->state();
-}
-
-void VariantStepper::update_parameters(const ms::MassSpringModel& model) {
-  if (explicit_) return explicit_->update_parameters(model);
-  implicit_->update_parameters(model);
-}
-
-bool VariantStepper::explicit_steps() const {
-  return explicit_ != nullptr;
-}
-
-const char* VariantStepper::name() const {
-  return explicit_ ? "fast_explicit" : "fast_implicit";
-}
 
 double timed_dt(const ms::MassSpringModel& model, const cases::TimingParameters& timing) {
   if (timing.dt_s > 0) return timing.dt_s;
@@ -134,14 +91,14 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
   // diverge at half that step. Such a step bounds the timed code's stable step: halve and retry.
   for (int attempt = 0;; ++attempt) {
     try {
-      VariantStepper stepper(model, kind, start, threads);
-      t.stepper = stepper.name();
-      if (measure_settling) settle(t, stepper, variant, start.x, equilibrium);
+      const auto stepper = ms::make_stepper(model, kind, start, {threads});
+      t.stepper = stepper->name();
+      if (measure_settling) settle(t, *stepper, variant, start.x, equilibrium);
       // Timed from msfem bench's start (every node moved a pseudo-random thousandth of the mean
       // spring length), not from the settled state: a model at rest needs fewer CG iterations a
       // step than a moving one, and the two commands would time different work.
-      VariantStepper timed(model, kind, ms::perturbed_start(model), threads);
-      t.steps_per_second = median_rate(timed, t.dt_s, timing.steps);
+      const auto timed = ms::make_stepper(model, kind, ms::perturbed_start(model), {threads});
+      t.steps_per_second = median_rate(*timed, t.dt_s, timing.steps);
       break;
     } catch (const ms::DivergenceError&) {
       if (timing.dt_s > 0 || attempt == 5) throw;

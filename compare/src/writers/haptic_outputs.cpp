@@ -7,8 +7,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "msfem/compare/writers/atomic_file.hpp"
-#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
+#include "msfem/compare/pipeline/json_values.hpp"
 #include "msfem/compare/writers/plots.hpp"
 #include "plot_render.hpp"
 

@@ -27,7 +27,7 @@
 #include <system_error>
 #include <vector>
 
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 
 extern char** environ;  // NOLINT: POSIX's, passed on so gnuplot finds its fonts and locale
 

@@ -9,7 +9,7 @@
 #include <optional>
 #include <sstream>
 
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/writers/error_picture.hpp"
 #include "msfem/compare/writers/fields_h5.hpp"
 #include "msfem/compare/writers/plots.hpp"

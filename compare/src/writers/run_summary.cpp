@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "msfem/cases/setting_names.hpp"
-#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/pipeline/json_values.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 
 namespace msfem::compare {

@@ -6,8 +6,8 @@
 #include <sstream>
 #include <tuple>
 
-#include "msfem/compare/writers/atomic_file.hpp"
-#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
+#include "msfem/compare/pipeline/json_values.hpp"
 #include "msfem/compare/writers/plots.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "msfem/cases/xml_text.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/writers/vtu.hpp"
 
 namespace msfem::compare {
@@ -22,7 +22,6 @@ namespace {
 // VTK cell type ids (vtkCellType.h).
 constexpr int kVtkTriangle = 5;
 constexpr int kVtkTetra = 10;
-
 
 std::string full_precision(double value) {
   char buffer[32];

@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "msfem/cases/x3d.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 
 namespace msfem::compare {
 namespace {

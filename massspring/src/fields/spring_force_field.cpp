@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
 
 namespace msfem::massspring {
 namespace {
@@ -27,6 +31,19 @@ void add_block(Triplets& triplets, int row_node, int col_node, const Eigen::Matr
 }
 
 }  // namespace
+
+SpringForceField::SpringForceField(const SpringNetwork& network)
+    : network_(&network), nodes_(static_cast<std::size_t>(network.num_nodes())) {
+  std::iota(nodes_.begin(), nodes_.end(), 0);
+}
+
+const SpringForceField& spring_field(const MechanicalSystem& system, const std::string& who) {
+  const auto* springs = system.find_field<SpringForceField>();
+  if (!springs)
+    throw ModelError(who + " needs a spring network: the system's fields (" + system.field_names() +
+                     ") hold no springs");
+  return *springs;
+}
 
 void SpringForceField::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                                  Eigen::VectorXd& f) const {
@@ -171,6 +188,27 @@ void SpringForceField::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& tri
   for (int i = 0; i < net.num_nodes(); ++i)
     for (int r = 0; r < 3; ++r)
       triplets.emplace_back(3 * i + r, 3 * i + r, -net.node_damping[i]);
+}
+
+void SpringForceField::add_diagonal_blocks(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                           double cx, double cv,
+                                           std::vector<Eigen::Matrix3d>& blocks,
+                                           Linearisation mode) const {
+  const SpringNetwork& net = *network_;
+  for (int s = 0; s < net.num_springs(); ++s) {
+    const int i = net.springs(s, 0);
+    const int j = net.springs(s, 1);
+    Eigen::Matrix3d block = cx * spring_dfdx_block(s, x, v, mode);
+    const SpringFrame fr = frame(x, i, j);
+    if (fr.valid && net.damping[s] != 0.0) block += cv * net.damping[s] * fr.n * fr.n.transpose();
+    blocks[static_cast<std::size_t>(i)] -= block;  // ∂f_i/∂x_i = -A
+    blocks[static_cast<std::size_t>(j)] -= block;
+  }
+  for (int a = 0; a < net.num_anchors(); ++a)
+    blocks[static_cast<std::size_t>(net.anchor_node[a])].diagonal().array() -=
+        cx * net.anchor_stiffness[a] + cv * net.anchor_damping[a];
+  for (int i = 0; i < net.num_nodes(); ++i)
+    blocks[static_cast<std::size_t>(i)].diagonal().array() -= cv * net.node_damping[i];
 }
 
 }  // namespace msfem::massspring

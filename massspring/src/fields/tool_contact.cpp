@@ -150,7 +150,7 @@ double activate_sphere_contact(MassSpringModel& model, const ToolIndentation& in
   return penalty_stiffness;
 }
 
-Eigen::Vector3d patch_reaction_force(const MassSpringModel& model, const Eigen::VectorXd& x,
+Eigen::Vector3d patch_reaction_force(const MechanicalSystem& model, const Eigen::VectorXd& x,
                                      const std::vector<int>& patch) {
   const Eigen::VectorXd f = model.force(x, Eigen::VectorXd::Zero(x.size()));
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
@@ -159,21 +159,23 @@ Eigen::Vector3d patch_reaction_force(const MassSpringModel& model, const Eigen::
   return total;
 }
 
-Eigen::Vector3d contact_reaction_force(const MassSpringModel& model, const Eigen::VectorXd& x) {
-  if (!model.contact()) return Eigen::Vector3d::Zero();
+Eigen::Vector3d contact_reaction_force(const MechanicalSystem& model, const Eigen::VectorXd& x) {
+  const auto* contact = model.find_field<ToolContact>();
+  if (!contact) return Eigen::Vector3d::Zero();
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size());
-  model.contact()->add_force(x, Eigen::VectorXd::Zero(x.size()), f);
+  contact->add_force(x, Eigen::VectorXd::Zero(x.size()), f);
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
-  for (int i : model.contact()->nodes())
+  for (int i : contact->nodes())
     total -= f.segment<3>(3 * i);
   return total;
 }
 
-int project_out_of_tool(const MassSpringModel& model, Eigen::VectorXd& x, Eigen::VectorXd& v) {
-  if (!model.contact()) return 0;
-  const SphereTool& tool = model.contact()->tool();
+int project_out_of_tool(const MechanicalSystem& model, Eigen::VectorXd& x, Eigen::VectorXd& v) {
+  const auto* contact = model.find_field<ToolContact>();
+  if (!contact) return 0;
+  const SphereTool& tool = contact->tool();
   int projected = 0;
-  for (int i : model.contact()->nodes()) {
+  for (int i : contact->nodes()) {
     const Eigen::Vector3d w = x.segment<3>(3 * i) - tool.center;
     const double rho = w.norm();
     if (rho >= tool.radius || !(rho > 0.0)) continue;

@@ -1,6 +1,6 @@
 #pragma once
 
-// Structure-of-arrays copy of a MassSpringModel shared by the fast steppers (internal): nodes
+// Structure-of-arrays copy of a system's springs shared by the fast steppers (internal): nodes
 // renumbered (reverse Cuthill-McKee, constrained nodes last), springs sorted by their first node,
 // CSR incidence of springs on free nodes, and the per-node constant terms (loads, anchors,
 // damping). The steppers' node-centric layout (node_gather_layout.hpp) is built from it.
@@ -19,7 +19,8 @@
 
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/integrators.hpp"
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/spring_force_field.hpp"
 #include "node_ordering.hpp"
 
 namespace msfem::massspring::detail {
@@ -36,9 +37,9 @@ struct SoaLayout {
   bool relative = false;
   std::vector<double> frame[3];  // relative: each node's frame position (float-representable)
 
-  SoaLayout(const MassSpringModel& model, bool reorder, bool relative_to_frame = false)
+  SoaLayout(const MechanicalSystem& model, bool reorder, bool relative_to_frame = false)
       : relative(relative_to_frame) {
-    const SpringNetwork& net = model.network();
+    const SpringNetwork& net = spring_field(model, "the fast stepper").network();
     num_nodes = net.num_nodes();
     num_springs = net.num_springs();
     build_order(model, reorder);
@@ -58,8 +59,8 @@ struct SoaLayout {
     set_state(model, initial_state(model));
   }
 
-  void load_parameters(const MassSpringModel& model) {
-    const SpringNetwork& net = model.network();
+  void load_parameters(const MechanicalSystem& model) {
+    const SpringNetwork& net = spring_field(model, "the fast stepper").network();
     if (net.num_nodes() != num_nodes || net.num_springs() != num_springs)
       throw ModelError(
           "fast stepper: model topology changed (nodes or springs); build a new stepper");
@@ -95,19 +96,19 @@ struct SoaLayout {
           v[c][i] = Real(0);
         }
       }
-      mass[i] = static_cast<Real>(net.masses[old]);
-      inverse_mass[i] = static_cast<Real>(1.0 / net.masses[old]);
+      mass[i] = static_cast<Real>(model.masses()[old]);
+      inverse_mass[i] = static_cast<Real>(1.0 / model.masses()[old]);
       node_damping[i] = static_cast<Real>(net.node_damping[old] + anchor_c[old]);
       anchor_stiffness[i] = static_cast<Real>(anchor_k[old]);
       // Relative: the anchor's -k_a (X + u - p) as the load's k_a (p - X) and -k_a u.
+      const Eigen::Vector3d node_load = model.node_load(old);
       for (int c = 0; c < 3; ++c)
-        load[c][i] = static_cast<Real>(net.masses[old] * model.gravity()[c] +
-                                       model.external_forces()(old, c) + anchor_kp(old, c) -
-                                       anchor_k[old] * frame_at(c, i));
+        load[c][i] =
+            static_cast<Real>(node_load[c] + anchor_kp(old, c) - anchor_k[old] * frame_at(c, i));
     }
   }
 
-  void set_state(const MassSpringModel& model, const State& state) {
+  void set_state(const MechanicalSystem& model, const State& state) {
     if (state.x.size() != 3 * num_nodes || state.v.size() != 3 * num_nodes)
       throw ModelError("fast stepper: state size " + std::to_string(state.x.size()) +
                        " does not match " + std::to_string(3 * num_nodes) + " dofs");
@@ -126,7 +127,7 @@ struct SoaLayout {
   }
 
  private:
-  void build_frame(const MassSpringModel& model) {
+  void build_frame(const MechanicalSystem& model) {
     const Eigen::VectorXd rest = initial_state(model).x;
     for (int c = 0; c < 3; ++c) {
       frame[c].resize(static_cast<std::size_t>(num_nodes));
@@ -136,10 +137,12 @@ struct SoaLayout {
     }
   }
 
-  void build_order(const MassSpringModel& model, bool reorder) {
+  void build_order(const MechanicalSystem& model, bool reorder) {
     order.resize(num_nodes);
     std::iota(order.begin(), order.end(), 0);
-    if (reorder) order = reverse_cuthill_mckee(num_nodes, model.network().springs);
+    if (reorder)
+      order = reverse_cuthill_mckee(num_nodes,
+                                    spring_field(model, "the fast stepper").network().springs);
     std::stable_partition(order.begin(), order.end(),
                           [&](int old) { return !model.is_constrained(old); });
     new_id.assign(num_nodes, 0);

@@ -24,12 +24,38 @@ void check_non_negative(double value, const std::string& item) {
 
 MassSpringModel::MassSpringModel(SpringNetwork network) : network_(std::move(network)) {
   network_.validate();
+  springs_ = std::make_shared<const SpringForceField>(network_);
+  fields_.push_back(springs_);
   const int n = network_.num_nodes();
   external_force_ = Eigen::MatrixX3d::Zero(n, 3);
   prescribed_displacement_ = Eigen::MatrixX3d::Zero(n, 3);
   constrained_.assign(n, 0);
   for (int node : network_.fixed_nodes)
     fix_node(node);
+}
+
+MassSpringModel::MassSpringModel(const MassSpringModel& other)
+    : network_(other.network_),
+      gravity_(other.gravity_),
+      external_force_(other.external_force_),
+      constrained_(other.constrained_),
+      prescribed_displacement_(other.prescribed_displacement_),
+      springs_(std::make_shared<const SpringForceField>(network_)),
+      fields_(other.fields_) {
+  fields_[0] = springs_;
+}
+
+MassSpringModel& MassSpringModel::operator=(const MassSpringModel& other) {
+  if (this == &other) return *this;
+  network_ = other.network_;
+  gravity_ = other.gravity_;
+  external_force_ = other.external_force_;
+  constrained_ = other.constrained_;
+  prescribed_displacement_ = other.prescribed_displacement_;
+  springs_ = std::make_shared<const SpringForceField>(network_);
+  fields_ = other.fields_;
+  fields_[0] = springs_;
+  return *this;
 }
 
 int MassSpringModel::check_node(int node, const char* what) const {
@@ -140,13 +166,6 @@ void MassSpringModel::release_node(int node) {
   prescribed_displacement_.row(node).setZero();
 }
 
-std::vector<int> MassSpringModel::constrained_nodes() const {
-  std::vector<int> nodes;
-  for (int i = 0; i < num_nodes(); ++i)
-    if (constrained_[i]) nodes.push_back(i);
-  return nodes;
-}
-
 Eigen::Vector3d MassSpringModel::constrained_target(int node) const {
   check_node(node, "node");
   return (network_.rest_positions.row(node) + prescribed_displacement_.row(node)).transpose();
@@ -172,15 +191,12 @@ void MassSpringModel::replace_field(std::size_t index, std::shared_ptr<const For
   if (index >= fields_.size())
     throw ModelError("force field " + std::to_string(index) + ": the model has " +
                      std::to_string(fields_.size()));
+  if (index == 0)
+    throw ModelError(
+        "force field 0 is the model's springs: change them through its stiffness, "
+        "damping and mass parameters");
   check_field(field.get(), num_nodes());
   fields_[index] = std::move(field);
-}
-
-std::string MassSpringModel::field_names() const {
-  std::string names;
-  for (const auto& f : fields_)
-    names += (names.empty() ? "" : ", ") + f->name();
-  return names;
 }
 
 void MassSpringModel::set_contact(const SphereContactForceField& contact) {
@@ -193,98 +209,6 @@ void MassSpringModel::set_contact(const SurfaceContactForceField& contact) {
 
 void MassSpringModel::set_volume(const VolumeForceField& volume) {
   set_field<VolumeForceField>(std::make_shared<const VolumeForceField>(volume));
-}
-
-void MassSpringModel::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                                Eigen::VectorXd& f) const {
-  springs().add_force(x, v, f);
-  for (int i = 0; i < num_nodes(); ++i)
-    f.segment<3>(3 * i) += network_.masses[i] * gravity_ + external_force_.row(i).transpose();
-  for (const auto& field : fields_)
-    field->add_force(x, v, f);
-}
-
-double MassSpringModel::potential_energy(const Eigen::VectorXd& x) const {
-  double energy = springs().potential_energy(x);
-  // Constant loads: U = -Σ (m_i g + f_i)·x_i.
-  for (int i = 0; i < num_nodes(); ++i)
-    energy -= (network_.masses[i] * gravity_ + external_force_.row(i).transpose())
-                  .dot(x.segment<3>(3 * i));
-  for (const auto& field : fields_)
-    energy += field->potential_energy(x);
-  return energy;
-}
-
-void MassSpringModel::add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                                       const Eigen::VectorXd& dx, Eigen::VectorXd& df,
-                                       Linearisation mode) const {
-  springs().add_dfdx_product(x, v, dx, df, mode);
-  for (const auto& field : fields_)
-    field->add_dfdx_product(x, v, dx, df, mode);
-}
-
-void MassSpringModel::add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
-                                       Eigen::VectorXd& df) const {
-  springs().add_dfdv_product(x, dv, df);
-  for (const auto& field : fields_)
-    field->add_dfdv_product(x, dv, df);
-}
-
-void MassSpringModel::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                                        Triplets& triplets, Linearisation mode) const {
-  springs().add_dfdx_triplets(x, v, triplets, mode);
-  for (const auto& field : fields_)
-    field->add_dfdx_triplets(x, v, triplets, mode);
-}
-
-void MassSpringModel::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const {
-  springs().add_dfdv_triplets(x, triplets);
-  for (const auto& field : fields_)
-    field->add_dfdv_triplets(x, triplets);
-}
-
-Eigen::VectorXd MassSpringModel::initial_state() const {
-  Eigen::VectorXd x = rest_state();
-  Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
-  enforce_constraints(x, v);
-  return x;
-}
-
-Eigen::VectorXd MassSpringModel::mass_per_dof() const {
-  Eigen::VectorXd m(num_dofs());
-  for (int i = 0; i < num_nodes(); ++i)
-    m.segment<3>(3 * i).setConstant(network_.masses[i]);
-  return m;
-}
-
-void MassSpringModel::enforce_constraints(Eigen::VectorXd& x, Eigen::VectorXd& v) const {
-  for (int i = 0; i < num_nodes(); ++i) {
-    if (!constrained_[i]) continue;
-    x.segment<3>(3 * i) =
-        (network_.rest_positions.row(i) + prescribed_displacement_.row(i)).transpose();
-    v.segment<3>(3 * i).setZero();
-  }
-}
-
-void MassSpringModel::zero_constrained(Eigen::VectorXd& vector) const {
-  for (int i = 0; i < num_nodes(); ++i)
-    if (constrained_[i]) vector.segment<3>(3 * i).setZero();
-}
-
-Eigen::VectorXd MassSpringModel::acceleration(const Eigen::VectorXd& x,
-                                              const Eigen::VectorXd& v) const {
-  Eigen::VectorXd a = Eigen::VectorXd::Zero(num_dofs());
-  add_force(x, v, a);
-  for (int i = 0; i < num_nodes(); ++i)
-    a.segment<3>(3 * i) *= constrained_[i] ? 0.0 : 1.0 / network_.masses[i];
-  return a;
-}
-
-double MassSpringModel::kinetic_energy(const Eigen::VectorXd& v) const {
-  double energy = 0.0;
-  for (int i = 0; i < num_nodes(); ++i)
-    energy += 0.5 * network_.masses[i] * v.segment<3>(3 * i).squaredNorm();
-  return energy;
 }
 
 Eigen::MatrixX3d MassSpringModel::surface_displacement(const Eigen::VectorXd& x) const {

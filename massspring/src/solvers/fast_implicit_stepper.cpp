@@ -18,7 +18,7 @@ namespace msfem::massspring {
 class FastImplicitStepper::Implementation {
  public:
   virtual ~Implementation() = default;
-  virtual void update_parameters(const MassSpringModel& model) = 0;
+  virtual void update_parameters(const MechanicalSystem& model) = 0;
   virtual void set_state(const State& state) = 0;
   virtual State state() const = 0;
   virtual void step(double h) = 0;
@@ -35,7 +35,7 @@ using detail::kRecord;
 template <class Real, int W>
 class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
  public:
-  GatherImplicitStepper(const MassSpringModel& model, const FastImplicitOptions& options)
+  GatherImplicitStepper(const MechanicalSystem& model, const FastImplicitOptions& options)
       : model_(&model),
         options_(options),
         team_(std::max(options.threads, 1)),
@@ -72,7 +72,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     pack();
   }
 
-  void update_parameters(const MassSpringModel& model) override {
+  void update_parameters(const MechanicalSystem& model) override {
     unpack();
     soa_.load_parameters(model);
     gather_.load_parameters(soa_);
@@ -203,7 +203,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 
   // The fields and the right-hand side vector they add to (kept by the linearising pass only
   // then: it costs a model without fields a store per lane).
-  void take_fields(const MassSpringModel& model) {
+  void take_fields(const MechanicalSystem& model) {
     fields_.take(model);
     const std::size_t lanes = gather_.lane_node.size();
     for (int c = 0; c < 3; ++c) {
@@ -246,7 +246,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       }
   }
 
-  const MassSpringModel* model_;
+  const MechanicalSystem* model_;
   FastImplicitOptions options_;
   detail::ThreadTeam team_;
   detail::AdaptiveThreads threads_;
@@ -274,11 +274,13 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 
 }  // namespace
 
-FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
+FastImplicitStepper::FastImplicitStepper(const MechanicalSystem& model,
                                          const FastImplicitOptions& options) {
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
   if (options.single_precision &&
-      detail::preferred_lanes<float>(true, model.network().num_springs(), model.num_nodes()) == 16)
+      detail::preferred_lanes<float>(
+          true, spring_field(model, "the fast stepper").network().num_springs(),
+          model.num_nodes()) == 16)
     impl_ = std::make_unique<GatherImplicitStepper<float, 16>>(model, options);
   else if (options.single_precision)
     impl_ = std::make_unique<GatherImplicitStepper<float, 8>>(model, options);
@@ -287,7 +289,7 @@ FastImplicitStepper::FastImplicitStepper(const MassSpringModel& model,
 }
 FastImplicitStepper::~FastImplicitStepper() = default;
 
-void FastImplicitStepper::update_parameters(const MassSpringModel& model) {
+void FastImplicitStepper::update_parameters(const MechanicalSystem& model) {
   impl_->update_parameters(model);
 }
 void FastImplicitStepper::set_state(const State& state) {
@@ -296,8 +298,9 @@ void FastImplicitStepper::set_state(const State& state) {
 State FastImplicitStepper::state() const {
   return impl_->state();
 }
-void FastImplicitStepper::step(double dt) {
-  impl_->step(dt);
+void FastImplicitStepper::step(double dt, int count) {
+  for (int n = 0; n < count; ++n)
+    impl_->step(dt);
 }
 int FastImplicitStepper::last_cg_iterations() const {
   return impl_->last_iterations();

@@ -21,7 +21,7 @@ namespace msfem::massspring {
 class FastExplicitStepper::Implementation {
  public:
   virtual ~Implementation() = default;
-  virtual void update_parameters(const MassSpringModel& model) = 0;
+  virtual void update_parameters(const MechanicalSystem& model) = 0;
   virtual void set_state(const State& state) = 0;
   virtual State state() const = 0;
   virtual void step(double dt, int count) = 0;
@@ -40,7 +40,7 @@ using detail::NodeGatherLayout;
 template <class Real, int W>
 class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
  public:
-  GatherExplicitStepper(const MassSpringModel& model, const FastStepperOptions& options)
+  GatherExplicitStepper(const MechanicalSystem& model, const FastStepperOptions& options)
       : model_(&model),
         team_(std::max(options.threads, 1)),
         threads_(team_.size(), options.adaptive_threads),
@@ -56,7 +56,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     pack();
   }
 
-  void update_parameters(const MassSpringModel& model) override {
+  void update_parameters(const MechanicalSystem& model) override {
     unpack();  // keep the current state; load_parameters moves only the supports
     soa_.load_parameters(model);
     gather_.load_parameters(soa_);
@@ -201,10 +201,12 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
  private:
   // The model's force fields and the nodes they read and push: gathered into full-size vectors
   // at those nodes only, so a field on a few nodes (the tool's contact) costs a step little.
-  void take_fields(const MassSpringModel& model) {
+  void take_fields(const MechanicalSystem& model) {
     fields_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_.num_nodes), 0);
+    const ForceField* springs = &spring_field(model, "the fast stepper");
     for (const auto& field : model.fields()) {
+      if (field.get() == springs) continue;  // the kernels' own
       fields_.push_back(field);
       for (int node : field->nodes())
         used[static_cast<std::size_t>(node)] = 1;
@@ -314,7 +316,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     throw DivergenceError(out.str(), dt, stable);
   }
 
-  const MassSpringModel* model_;
+  const MechanicalSystem* model_;
   detail::ThreadTeam team_;
   detail::AdaptiveThreads threads_;
   detail::SoaLayout<Real> soa_;
@@ -335,16 +337,18 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
 }  // namespace
 
-FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
-                                         const FastStepperOptions& options) {
+FastExplicitStepper::FastExplicitStepper(const MechanicalSystem& model,
+                                         const FastStepperOptions& options)
+    : kind_(options.integrator) {
   if (options.integrator != IntegratorKind::symplectic_euler &&
       options.integrator != IntegratorKind::explicit_euler &&
       options.integrator != IntegratorKind::rk4)
     throw ModelError("fast explicit stepper: integrator '" + to_string(options.integrator) +
                      "' not supported (symplectic_euler, explicit_euler, rk4)");
   if (options.single_precision &&
-      detail::preferred_lanes<float>(options.allow_avx512, model.network().num_springs(),
-                                     model.num_nodes()) == 16)
+      detail::preferred_lanes<float>(
+          options.allow_avx512, spring_field(model, "the fast stepper").network().num_springs(),
+          model.num_nodes()) == 16)
     impl_ = std::make_unique<GatherExplicitStepper<float, 16>>(model, options);
   else if (options.single_precision)
     impl_ = std::make_unique<GatherExplicitStepper<float, 8>>(model, options);
@@ -354,7 +358,7 @@ FastExplicitStepper::FastExplicitStepper(const MassSpringModel& model,
 
 FastExplicitStepper::~FastExplicitStepper() = default;
 
-void FastExplicitStepper::update_parameters(const MassSpringModel& model) {
+void FastExplicitStepper::update_parameters(const MechanicalSystem& model) {
   impl_->update_parameters(model);
 }
 void FastExplicitStepper::set_state(const State& state) {

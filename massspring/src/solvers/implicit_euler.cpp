@@ -6,38 +6,46 @@
 #include <vector>
 
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring {
 namespace {
 
 // Diagonal of the system for Jacobi preconditioning: m_i + h (c_i + Σ d_s) + h² Σ k_s over the
-// springs at node i (the exact diagonal up to the n nᵀ direction factors, which are <= 1), and
-// the diagonal of each field's own blocks of -h ∂f/∂v - h² ∂f/∂x.
-Eigen::VectorXd jacobi_diagonal(const MassSpringModel& model, const State& state, double h) {
-  const SpringNetwork& net = model.network();
-  Eigen::VectorXd per_node = net.masses + h * net.node_damping;
-  for (int s = 0; s < net.num_springs(); ++s) {
-    const double add = h * net.damping[s] + h * h * net.stiffness[s];
-    per_node[net.springs(s, 0)] += add;
-    per_node[net.springs(s, 1)] += add;
+// springs at node i (the exact diagonal up to the n nᵀ direction factors, which are <= 1, and
+// cheaper than the springs' blocks), and the diagonal of every other field's own blocks of
+// -h ∂f/∂v - h² ∂f/∂x.
+Eigen::VectorXd jacobi_diagonal(const MechanicalSystem& model, const State& state, double h) {
+  const int nodes = model.num_nodes();
+  Eigen::VectorXd per_node = model.masses();
+  const auto* springs = model.find_field<SpringForceField>();
+  if (springs) {
+    const SpringNetwork& net = springs->network();
+    per_node += h * net.node_damping;
+    for (int s = 0; s < net.num_springs(); ++s) {
+      const double add = h * net.damping[s] + h * h * net.stiffness[s];
+      per_node[net.springs(s, 0)] += add;
+      per_node[net.springs(s, 1)] += add;
+    }
+    for (int a = 0; a < net.num_anchors(); ++a)
+      per_node[net.anchor_node[a]] += h * net.anchor_damping[a] + h * h * net.anchor_stiffness[a];
   }
-  for (int a = 0; a < net.num_anchors(); ++a)
-    per_node[net.anchor_node[a]] += h * net.anchor_damping[a] + h * h * net.anchor_stiffness[a];
-  Eigen::VectorXd diagonal(3 * net.num_nodes());
-  for (int i = 0; i < net.num_nodes(); ++i)
+  Eigen::VectorXd diagonal(3 * nodes);
+  for (int i = 0; i < nodes; ++i)
     diagonal.segment<3>(3 * i).setConstant(per_node[i]);
-  if (model.fields().empty()) return diagonal;
-  std::vector<Eigen::Matrix3d> blocks(net.num_nodes(), Eigen::Matrix3d::Zero());
+  if (model.fields().size() == (springs ? 1u : 0u)) return diagonal;
+  std::vector<Eigen::Matrix3d> blocks(static_cast<std::size_t>(nodes), Eigen::Matrix3d::Zero());
   for (const auto& field : model.fields())
-    field->add_diagonal_blocks(state.x, state.v, -h * h, -h, blocks, Linearisation::definite);
-  for (int i = 0; i < net.num_nodes(); ++i)
-    diagonal.segment<3>(3 * i) += blocks[i].diagonal();
+    if (field.get() != springs)
+      field->add_diagonal_blocks(state.x, state.v, -h * h, -h, blocks, Linearisation::definite);
+  for (int i = 0; i < nodes; ++i)
+    diagonal.segment<3>(3 * i) += blocks[static_cast<std::size_t>(i)].diagonal();
   return diagonal;
 }
 
 }  // namespace
 
-void Integrator::implicit_euler_step(const MassSpringModel& model, State& state, double h) {
+void Integrator::implicit_euler_step(const MechanicalSystem& model, State& state, double h) {
   const Eigen::VectorXd& x = state.x;
   const Eigen::VectorXd& v = state.v;
   const Eigen::VectorXd mass = model.mass_per_dof();

@@ -14,7 +14,8 @@
 #include <vector>
 
 #include "kernels/node_gather_layout.hpp"
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring::detail {
 
@@ -27,11 +28,13 @@ class ImplicitFields {
   bool empty() const { return fields_.empty(); }
 
   // The model's fields and, per field node, its new id, lane and block (-1 when constrained).
-  void take(const MassSpringModel& model) {
+  void take(const MechanicalSystem& model) {
     fields_.clear();
     tangents_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
+    const ForceField* springs = &spring_field(model, "the fast stepper");
     for (const auto& field : model.fields()) {
+      if (field.get() == springs) continue;  // the kernels' own
       fields_.push_back(field);
       tangents_.push_back(field->tangent(x_, v_, Linearisation::definite));
       for (int node : field->nodes())

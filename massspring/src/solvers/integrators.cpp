@@ -1,4 +1,5 @@
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/tool_contact.hpp"
 
 #include <cmath>
 
@@ -6,7 +7,7 @@
 
 namespace msfem::massspring {
 
-State initial_state(const MassSpringModel& model) {
+State initial_state(const MechanicalSystem& model) {
   State state{model.rest_state(), Eigen::VectorXd::Zero(model.num_dofs()), 0.0};
   model.enforce_constraints(state.x, state.v);
   return state;
@@ -35,7 +36,7 @@ void check_time_step(double dt) {
     throw ModelError("time step dt = " + std::to_string(dt) + " s must be finite and > 0");
 }
 
-void Integrator::step(const MassSpringModel& model, State& state, double dt) {
+void Integrator::step(const MechanicalSystem& model, State& state, double dt) {
   check_time_step(dt);
   if (state.x.size() != model.num_dofs() || state.v.size() != model.num_dofs())
     throw ModelError("state: size " + std::to_string(state.x.size()) + " does not match " +

@@ -2,38 +2,49 @@
 
 #include <stdexcept>
 
+#include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/spring_force_field.hpp"
+
 #include "static_linear.hpp"
 
 namespace msfem::massspring {
 
 LinearisedStatics::LinearisedStatics(
-    const MassSpringModel& model, const std::vector<Eigen::VectorXd>& parts,
+    const MechanicalSystem& model, const std::vector<Eigen::VectorXd>& parts,
     std::function<std::unique_ptr<SparseSpdFactor>()> factorization)
     : model_(model),
       cholesky_(
           std::make_unique<detail::TangentFactor>(factorization ? factorization() : nullptr)) {
   const int n = model.num_dofs();
   const Eigen::VectorXd rest = model.rest_state();
-  const std::size_t fields = model.fields().size();
-  field_rest_force_.resize(parts.size() + fields);
-  for (std::size_t p = 0; p < parts.size() + fields; ++p) {
-    MassSpringModel part = model;
-    const bool field_part = p >= parts.size();
-    if (field_part) {
-      Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
-      model.fields()[p - parts.size()]->add_force(rest, Eigen::VectorXd::Zero(n), f);
-      if (!f.isZero(0.0)) field_rest_force_[p] = f;
-    }
-    part.set_stiffness(field_part ? Eigen::VectorXd::Zero(model.network().num_springs())
-                                  : parts[p]);
-    if (p > 0 && part.network().num_anchors() > 0) part.set_anchor_parameters(0.0, 0.0);
-    part.clear_fields<ForceField>();
-    if (field_part) part.add_field(model.fields()[p - parts.size()]);
+  const Eigen::VectorXd still = Eigen::VectorXd::Zero(n);
+  const SpringForceField& springs = spring_field(model, "the linearised statics");
+  std::vector<const ForceField*> fields;
+  for (const auto& field : model.fields())
+    if (field.get() != &springs) fields.push_back(field.get());
+  field_rest_force_.resize(parts.size() + fields.size());
+  auto jacobian = [&](const ForceField& part) {
     Triplets t;
-    part.add_dfdx_triplets(rest, Eigen::VectorXd::Zero(n), t, Linearisation::exact);
+    part.add_dfdx_triplets(rest, still, t, Linearisation::exact);
     Eigen::SparseMatrix<double> j(n, n);
     j.setFromTriplets(t.begin(), t.end());
     jacobians_.push_back(j);
+  };
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    SpringNetwork part = springs.network();
+    if (parts[p].size() != part.num_springs())
+      throw ModelError("linearised statics: part " + std::to_string(p) + " has " +
+                       std::to_string(parts[p].size()) + " stiffnesses for " +
+                       std::to_string(part.num_springs()) + " springs");
+    part.stiffness = parts[p];
+    if (p > 0) part.anchor_stiffness.setZero();  // the anchors belong to part 0
+    jacobian(SpringForceField(part));
+  }
+  for (std::size_t q = 0; q < fields.size(); ++q) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+    fields[q]->add_force(rest, still, f);
+    if (!f.isZero(0.0)) field_rest_force_[parts.size() + q] = f;
+    jacobian(*fields[q]);
   }
   std::vector<Eigen::Triplet<double>> s;
   prescribed_ = Eigen::VectorXd::Zero(n);
@@ -85,7 +96,7 @@ LinearisedStatics::Solution LinearisedStatics::solve(const std::vector<double>& 
         std::to_string(u.cwiseAbs().maxCoeff() / pushed) +
         " times the prescribed displacement): it needs the deformed state to stiffen it");
   Solution s;
-  const auto& surface = model_.network().surface_nodes;
+  const auto& surface = spring_field(model_, "the linearised statics").network().surface_nodes;
   s.surface_displacement.resize(static_cast<Eigen::Index>(surface.size()), 3);
   for (std::size_t v = 0; v < surface.size(); ++v)
     s.surface_displacement.row(static_cast<Eigen::Index>(v)) =

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "msfem/massspring/spring_force_field.hpp"
 #include "static_linear.hpp"
 
 namespace msfem::massspring {
@@ -33,7 +34,7 @@ Eigen::VectorXd damping_for_ratio(const SpringNetwork& network, double ratio) {
   return d;
 }
 
-DampingFit fit_damping(const MassSpringModel& model, const Eigen::VectorXd& x, double target,
+DampingFit fit_damping(const MechanicalSystem& model, const Eigen::VectorXd& x, double target,
                        const Eigen::VectorXd& shape) {
   const detail::FreeDofs dofs(model);
   const int n = static_cast<int>(dofs.full_index.size());
@@ -79,11 +80,14 @@ DampingFit fit_damping(const MassSpringModel& model, const Eigen::VectorXd& x, d
   if (!(omega2 > 0)) throw std::runtime_error("fit_damping: the mode has no stiffness");
   const double omega = std::sqrt(omega2);
   // Modal ratio ζ(r) = vᵀC(r)v / (2ω vᵀMv), with vᵀMv = 1; C is linear in r: ζ(r) = ζ0 + r ζ1.
+  const SpringForceField& springs = spring_field(model, "the damping fit");
   auto modal_ratio = [&](double r) {
-    MassSpringModel copy = model;
-    copy.set_damping(damping_for_ratio(copy.network(), r));
+    SpringNetwork damped = springs.network();
+    damped.damping = damping_for_ratio(damped, r);
     Triplets ct;
-    copy.add_dfdv_triplets(x, ct);
+    SpringForceField(damped).add_dfdv_triplets(x, ct);
+    for (const auto& field : model.fields())
+      if (field.get() != &springs) field->add_dfdv_triplets(x, ct);
     return v.dot(restricted(dofs, ct) * v) / (2.0 * omega);
   };
   DampingFit f;

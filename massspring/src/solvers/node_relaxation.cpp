@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include "msfem/massspring/spring_force_field.hpp"
+
 namespace msfem::massspring::detail {
 namespace {
 
@@ -27,28 +29,35 @@ void bucket(int num_nodes, int num_items, int per_item, NodesOf nodes_of, std::v
 
 }  // namespace
 
-NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
-  const SpringNetwork& net = model.network();
+NodeRelaxation::NodeRelaxation(const MechanicalSystem& model) : model_(model) {
+  // Without springs (a system of other fields alone) only the nodewise fields are relaxed here.
+  static const SpringNetwork no_springs;
+  springs_field_ = model.find_field<SpringForceField>();
+  network_ = springs_field_ ? &springs_field_->network() : &no_springs;
+  const SpringNetwork& net = *network_;
+  const int nodes = model.num_nodes();
   bucket(
-      net.num_nodes(), net.num_springs(), 2, [&](int s, int e) { return net.springs(s, e); },
-      spring_start_, springs_);
+      nodes, net.num_springs(), 2, [&](int s, int e) { return net.springs(s, e); }, spring_start_,
+      springs_);
   bucket(
-      net.num_nodes(), net.num_anchors(), 1, [&](int a, int) { return net.anchor_node[a]; },
-      anchor_start_, anchors_);
+      nodes, net.num_anchors(), 1, [&](int a, int) { return net.anchor_node[a]; }, anchor_start_,
+      anchors_);
   // A nodewise field's energy (a node contact's) is local to each node, and relaxed here with the
   // springs'. Any other field's may couple its nodes (a volume element's couples all of it, a
   // surface contact's triangle its three): those nodes are left to Newton.
-  left_to_newton_.assign(net.num_nodes(), 0);
+  left_to_newton_.assign(static_cast<std::size_t>(nodes), 0);
   std::vector<std::pair<int, const ForceField*>> terms;
-  for (const auto& field : model.fields())
+  for (const auto& field : model.fields()) {
+    if (field.get() == springs_field_) continue;
     for (int i : field->nodes())
       if (field->nodewise())
         terms.emplace_back(i, field.get());
       else
-        left_to_newton_[i] = 1;
+        left_to_newton_[static_cast<std::size_t>(i)] = 1;
+  }
   bucket(
-      net.num_nodes(), static_cast<int>(terms.size()), 1,
-      [&](int t, int) { return terms[t].first; }, node_term_start_, node_term_);
+      nodes, static_cast<int>(terms.size()), 1, [&](int t, int) { return terms[t].first; },
+      node_term_start_, node_term_);
   node_term_field_.resize(terms.size());
   for (std::size_t t = 0; t < terms.size(); ++t)
     node_term_field_[t] = terms[t].second;
@@ -56,9 +65,8 @@ NodeRelaxation::NodeRelaxation(const MassSpringModel& model) : model_(model) {
 
 double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vector3d& p,
                              Eigen::Vector3d* force, Eigen::Matrix3d* stiffness) const {
-  const SpringNetwork& net = model_.network();
-  const Eigen::Vector3d load =
-      net.masses[i] * model_.gravity() + model_.external_forces().row(i).transpose();
+  const SpringNetwork& net = *network_;
+  const Eigen::Vector3d load = model_.node_load(i);
   const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
   double energy = -load.dot(p);
   Eigen::Vector3d f = load;

@@ -5,7 +5,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring::detail {
 
@@ -20,7 +21,7 @@ namespace msfem::massspring::detail {
 /// iterations. Putting each such node back at its own minimum costs microseconds and removes it.
 class NodeRelaxation {
  public:
-  explicit NodeRelaxation(const MassSpringModel& model);
+  explicit NodeRelaxation(const MechanicalSystem& model);
 
   /// Relaxes the free nodes whose |f_i| is at least `fraction` × max |f_i| (f given on all dofs,
   /// zero on constrained ones), `sweeps` times. Returns the number of nodes visited per sweep.
@@ -33,11 +34,13 @@ class NodeRelaxation {
                Eigen::Matrix3d* stiffness) const;
   void relax_node(Eigen::VectorXd& x, int i) const;
 
-  const MassSpringModel& model_;
-  std::vector<int> spring_start_, springs_;         // springs at each node (CSR)
-  std::vector<int> anchor_start_, anchors_;         // anchors at each node (CSR)
-  std::vector<int> node_term_start_, node_term_;    // nodewise fields' terms at each node (CSR)
-  std::vector<const ForceField*> node_term_field_;  // each term's field
+  const MechanicalSystem& model_;
+  const SpringForceField* springs_field_ = nullptr;  // the system's springs, if it has them
+  const SpringNetwork* network_ = nullptr;           // theirs, or an empty one
+  std::vector<int> spring_start_, springs_;          // springs at each node (CSR)
+  std::vector<int> anchor_start_, anchors_;          // anchors at each node (CSR)
+  std::vector<int> node_term_start_, node_term_;     // nodewise fields' terms at each node (CSR)
+  std::vector<const ForceField*> node_term_field_;   // each term's field
   std::vector<char> left_to_newton_;  // node's energy is not local (volume, surface contact)
 };
 

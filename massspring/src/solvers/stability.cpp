@@ -7,10 +7,54 @@
 #include <sstream>
 
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/spring_force_field.hpp"
+#include "msfem/massspring/tool_contact.hpp"
 
 namespace msfem::massspring {
+namespace {
 
-SpectralEstimate estimate_max_eigenvalue(const MassSpringModel& model, const Eigen::VectorXd& x,
+// The system without its loads and its tool's contact: stability is a property of M, K and the
+// damping, not of the loads.
+class UnloadedSystem : public MechanicalSystem {
+ public:
+  explicit UnloadedSystem(const MechanicalSystem& system)
+      : system_(system), springs_(system.find_field<SpringForceField>()) {
+    for (const auto& field : system.fields())
+      if (!dynamic_cast<const ToolContact*>(field.get())) fields_.push_back(field);
+  }
+  int num_nodes() const override { return system_.num_nodes(); }
+  Eigen::VectorXd rest_state() const override { return system_.rest_state(); }
+  const Eigen::VectorXd& masses() const override { return system_.masses(); }
+  bool is_constrained(int node) const override { return system_.is_constrained(node); }
+  Eigen::Vector3d constrained_target(int node) const override {
+    return system_.constrained_target(node);
+  }
+  Eigen::Vector3d node_load(int) const override { return Eigen::Vector3d::Zero(); }
+  const FieldList& fields() const override { return fields_; }
+
+  // The springs' energy where there are springs (the energy a run away oscillation feeds), the
+  // fields' otherwise.
+  double elastic_energy(const Eigen::VectorXd& x) const {
+    return springs_ ? springs_->potential_energy(x) : potential_energy(x);
+  }
+  // The springs' mean rest length, or the rest state's extent over the cube root of its nodes.
+  double length_scale() const {
+    if (springs_ && springs_->network().num_springs() > 0)
+      return springs_->network().rest_length.mean();
+    const Eigen::MatrixX3d rest = unflatten(rest_state());
+    const double extent = (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
+    return extent / std::cbrt(std::max(num_nodes(), 1));
+  }
+
+ private:
+  const MechanicalSystem& system_;
+  const SpringForceField* springs_;
+  FieldList fields_;
+};
+
+}  // namespace
+
+SpectralEstimate estimate_max_eigenvalue(const MechanicalSystem& model, const Eigen::VectorXd& x,
                                          int max_iterations, double tolerance) {
   const Eigen::Index n = x.size();
   const Eigen::VectorXd inv_sqrt_mass = model.mass_per_dof().cwiseSqrt().cwiseInverse();
@@ -48,7 +92,7 @@ SpectralEstimate estimate_max_eigenvalue(const MassSpringModel& model, const Eig
   return estimate;
 }
 
-double predicted_stable_dt(const MassSpringModel& model, IntegratorKind kind,
+double predicted_stable_dt(const MechanicalSystem& model, IntegratorKind kind,
                            const Eigen::VectorXd& x) {
   if (kind == IntegratorKind::implicit_euler) return std::numeric_limits<double>::infinity();
   const SpectralEstimate spectrum = estimate_max_eigenvalue(model, x);
@@ -79,10 +123,13 @@ double predicted_stable_dt(const MassSpringModel& model, IntegratorKind kind,
   return std::numeric_limits<double>::infinity();
 }
 
-std::string divergence_reason(const MassSpringModel& model, const State& state, double max_strain) {
+std::string divergence_reason(const MechanicalSystem& model, const State& state,
+                              double max_strain) {
   if (!state.x.allFinite()) return "non-finite position";
   if (!state.v.allFinite()) return "non-finite velocity";
-  const SpringNetwork& net = model.network();
+  const auto* springs = model.find_field<SpringForceField>();
+  if (!springs) return "";
+  const SpringNetwork& net = springs->network();
   const double stretch_limit = 1.0 + max_strain;
   for (int s = 0; s < net.num_springs(); ++s) {
     const double length =
@@ -98,7 +145,7 @@ std::string divergence_reason(const MassSpringModel& model, const State& state, 
   return "";
 }
 
-void run_dynamics(const MassSpringModel& model, Integrator& integrator, State& state, double dt,
+void run_dynamics(const MechanicalSystem& model, Integrator& integrator, State& state, double dt,
                   int steps, const RunOptions& options) {
   check_time_step(dt);
   const int every = std::max(options.check_every, 1);
@@ -116,27 +163,23 @@ void run_dynamics(const MassSpringModel& model, Integrator& integrator, State& s
   }
 }
 
-double measure_stable_dt(const MassSpringModel& model, IntegratorKind kind, double dt_low,
+double measure_stable_dt(const MechanicalSystem& model, IntegratorKind kind, double dt_low,
                          double dt_high, int steps, double relative_tolerance) {
   check_time_step(dt_low);
   check_time_step(dt_high);
   if (!(dt_high > dt_low))
     throw ModelError("stable dt bisection: dt_high " + std::to_string(dt_high) +
                      " must exceed dt_low " + std::to_string(dt_low));
-  // Unloaded copy: stability is a property of M, K and the damping, not of the loads.
-  MassSpringModel probe = model;
-  probe.set_gravity(Eigen::Vector3d::Zero());
-  probe.clear_external_forces();
-  probe.clear_contact();
+  const UnloadedSystem probe(model);
   State start = initial_state(probe);
-  const double scale = 1e-4 * probe.network().rest_length.mean();
+  const double scale = 1e-4 * probe.length_scale();
   std::mt19937 generator(4242);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (Eigen::Index k = 0; k < start.x.size(); ++k)
     start.x[k] += scale * uniform(generator);
   probe.enforce_constraints(start.x, start.v);
   auto energy = [&](const State& s) {
-    return probe.kinetic_energy(s.v) + probe.springs().potential_energy(s.x);
+    return probe.kinetic_energy(s.v) + probe.elastic_energy(s.x);
   };
   const double initial_energy = energy(start);
   auto bounded = [&](double dt) {

@@ -5,7 +5,7 @@
 
 namespace msfem::massspring::detail {
 
-FreeDofs::FreeDofs(const MassSpringModel& model) {
+FreeDofs::FreeDofs(const MechanicalSystem& model) {
   free_index.assign(model.num_dofs(), -1);
   for (int i = 0; i < model.num_nodes(); ++i) {
     if (model.is_constrained(i)) continue;
@@ -28,7 +28,7 @@ void FreeDofs::scatter_add(const Eigen::VectorXd& free, double scale, Eigen::Vec
     full[full_index[k]] += scale * free[k];
 }
 
-Eigen::SparseMatrix<double> free_stiffness(const MassSpringModel& model, const Eigen::VectorXd& x,
+Eigen::SparseMatrix<double> free_stiffness(const MechanicalSystem& model, const Eigen::VectorXd& x,
                                            const FreeDofs& dofs, Linearisation mode) {
   Triplets all;
   model.add_dfdx_triplets(x, Eigen::VectorXd::Zero(x.size()), all, mode);
@@ -49,7 +49,7 @@ Eigen::SparseMatrix<double> free_stiffness(const MassSpringModel& model, const E
   return k;
 }
 
-TangentOperator::TangentOperator(const MassSpringModel& model, const FreeDofs& dofs,
+TangentOperator::TangentOperator(const MechanicalSystem& model, const FreeDofs& dofs,
                                  const Eigen::VectorXd& x, Linearisation mode)
     : model_(model),
       dofs_(dofs),

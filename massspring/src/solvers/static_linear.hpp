@@ -11,14 +11,14 @@
 #include <memory>
 #include <vector>
 
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
 #include "msfem/massspring/static_solver.hpp"
 
 namespace msfem::massspring::detail {
 
 /// Maps full dofs to free dofs (-1 for constrained) and back.
 struct FreeDofs {
-  explicit FreeDofs(const MassSpringModel& model);
+  explicit FreeDofs(const MechanicalSystem& model);
   int size() const { return static_cast<int>(full_index.size()); }
   Eigen::VectorXd gather(const Eigen::VectorXd& full) const;
   void scatter_add(const Eigen::VectorXd& free, double scale, Eigen::VectorXd& full) const;
@@ -30,18 +30,18 @@ struct FreeDofs {
 /// K = -∂f/∂x restricted to the free dofs. Every spring's blocks and every free node's diagonal
 /// block are stored even when zero (a collapsed spring, contact
 /// switched off), so the pattern depends only on the topology and the supports.
-Eigen::SparseMatrix<double> free_stiffness(const MassSpringModel& model, const Eigen::VectorXd& x,
+Eigen::SparseMatrix<double> free_stiffness(const MechanicalSystem& model, const Eigen::VectorXd& x,
                                            const FreeDofs& dofs, Linearisation mode);
 
 /// y = K v on the free dofs without assembling K (a few ms on the brain against ~0.2 s assembly).
 class TangentOperator {
  public:
-  TangentOperator(const MassSpringModel& model, const FreeDofs& dofs, const Eigen::VectorXd& x,
+  TangentOperator(const MechanicalSystem& model, const FreeDofs& dofs, const Eigen::VectorXd& x,
                   Linearisation mode);
   Eigen::VectorXd operator*(const Eigen::VectorXd& v) const;
 
  private:
-  const MassSpringModel& model_;
+  const MechanicalSystem& model_;
   const FreeDofs& dofs_;
   const Eigen::VectorXd& x_;
   Linearisation mode_;

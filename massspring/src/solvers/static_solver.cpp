@@ -51,7 +51,7 @@ bool solve_jacobi_cg(const SparseMatrix& k, const Eigen::VectorXd& r, Eigen::Vec
 // iterations, where it preconditions CG on the next tangent.
 class DirectionFinder {
  public:
-  DirectionFinder(const MassSpringModel& model, const FreeDofs& dofs, const StaticOptions& options)
+  DirectionFinder(const MechanicalSystem& model, const FreeDofs& dofs, const StaticOptions& options)
       : model_(model),
         dofs_(dofs),
         options_(options),
@@ -139,7 +139,7 @@ class DirectionFinder {
     return outcome;
   }
 
-  const MassSpringModel& model_;
+  const MechanicalSystem& model_;
   const FreeDofs& dofs_;
   const StaticOptions& options_;
   const Eigen::VectorXd free_mass_;
@@ -157,7 +157,7 @@ struct LineSearchResult {
 // too long and by secant extrapolation when it is too short. Too short is common on the brain:
 // along its near-mechanisms U stiffens faster than quadratically, a full Newton step covers only
 // part of the way, and plain backtracking never lengthens it.
-LineSearchResult line_search(const MassSpringModel& model, const FreeDofs& dofs,
+LineSearchResult line_search(const MechanicalSystem& model, const FreeDofs& dofs,
                              const Eigen::VectorXd& x, const Eigen::VectorXd& r,
                              const Eigen::VectorXd& d, double target, bool wolfe) {
   constexpr double c1 = 1e-4;
@@ -233,13 +233,10 @@ LineSearchResult line_search(const MassSpringModel& model, const FreeDofs& dofs,
 
 // |f_free| of the applied loads (gravity, external forces) and of the initial state, whose
 // larger is the scale of the problem: neither depends on where Newton starts.
-double reference_norm(const MassSpringModel& model, const FreeDofs& dofs) {
+double reference_norm(const MechanicalSystem& model, const FreeDofs& dofs) {
   double load_norm_squared = 0.0;
   for (int i = 0; i < model.num_nodes(); ++i)
-    if (!model.is_constrained(i))
-      load_norm_squared +=
-          (model.network().masses[i] * model.gravity() + model.external_forces().row(i).transpose())
-              .squaredNorm();
+    if (!model.is_constrained(i)) load_norm_squared += model.node_load(i).squaredNorm();
   const Eigen::VectorXd x0 = model.initial_state();
   const double initial = dofs.gather(model.force(x0, Eigen::VectorXd::Zero(x0.size()))).norm();
   return std::max(std::sqrt(load_norm_squared), initial);
@@ -249,7 +246,7 @@ double reference_norm(const MassSpringModel& model, const FreeDofs& dofs) {
 // positions carry a relative error ε, so |f| cannot be resolved below about ε k_max |x| per
 // coordinate. A target under it is met by no iterate, and Newton then wanders (along an
 // indefinite tangent, or with steps the line search cannot judge) instead of stopping.
-double roundoff_floor(const MassSpringModel& model, const FreeDofs& dofs,
+double roundoff_floor(const MechanicalSystem& model, const FreeDofs& dofs,
                       const Eigen::VectorXd& x) {
   double x_scale = 0.0;
   for (int k : dofs.full_index)
@@ -262,7 +259,7 @@ double roundoff_floor(const MassSpringModel& model, const FreeDofs& dofs,
 
 }  // namespace
 
-StaticResult solve_static(const MassSpringModel& model, const StaticOptions& options,
+StaticResult solve_static(const MechanicalSystem& model, const StaticOptions& options,
                           const Eigen::VectorXd& start) {
   const FreeDofs dofs(model);
   StaticResult result;

@@ -3,7 +3,8 @@
 #include <memory>
 
 #include "msfem/massspring/integrators.hpp"
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/stepper.hpp"
 
 namespace msfem::massspring {
 
@@ -40,19 +41,21 @@ struct FastImplicitOptions {
 /// blocks in the preconditioner (one more barrier per product), and a field on every node
 /// (volume preservation) shares its elements among the threads. The model must outlive the
 /// stepper.
-class FastImplicitStepper {
+class FastImplicitStepper : public Stepper {
  public:
-  explicit FastImplicitStepper(const MassSpringModel& model,
+  explicit FastImplicitStepper(const MechanicalSystem& model,
                                const FastImplicitOptions& options = {});
   ~FastImplicitStepper();
   FastImplicitStepper(const FastImplicitStepper&) = delete;
   FastImplicitStepper& operator=(const FastImplicitStepper&) = delete;
 
-  void update_parameters(const MassSpringModel& model);
-  void set_state(const State& state);
-  State state() const;
-  /// One backward-Euler step. Throws ModelError for a bad dt.
-  void step(double dt);
+  void update_parameters(const MechanicalSystem& model) override;
+  void set_state(const State& state) override;
+  State state() const override;
+  /// `count` backward-Euler steps. Throws ModelError for a bad dt.
+  void step(double dt, int count = 1) override;
+  IntegratorKind kind() const override { return IntegratorKind::implicit_euler; }
+  const char* name() const override { return "fast_implicit"; }
   int last_cg_iterations() const;
   /// Threads the last step ran on (1 while adaptive_threads found one faster).
   int last_step_threads() const;

@@ -4,7 +4,8 @@
 #include <memory>
 
 #include "msfem/massspring/integrators.hpp"
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/stepper.hpp"
 
 namespace msfem::massspring {
 
@@ -48,9 +49,9 @@ struct FastStepperOptions {
 /// a thread the OS pre-empts delays a step by one block. The kernels (gather_kernels.hpp) are
 /// compiled for baseline x86-64, AVX2+FMA (float 8 lanes, double 4) and AVX-512 (float 16, while
 /// the model fits in cache) and picked at run time.
-class FastExplicitStepper {
+class FastExplicitStepper : public Stepper {
  public:
-  explicit FastExplicitStepper(const MassSpringModel& model,
+  explicit FastExplicitStepper(const MechanicalSystem& model,
                                const FastStepperOptions& options = {});
   ~FastExplicitStepper();
   FastExplicitStepper(const FastExplicitStepper&) = delete;
@@ -58,14 +59,18 @@ class FastExplicitStepper {
 
   /// Re-reads stiffness, damping, masses, gravity, external forces and support targets from the
   /// model (same topology and the same constrained nodes), e.g. after a change of group stiffness.
-  void update_parameters(const MassSpringModel& model);
+  void update_parameters(const MechanicalSystem& model) override;
 
-  void set_state(const State& state);
-  State state() const;
+  void set_state(const State& state) override;
+  State state() const override;
 
   /// Advances `count` steps of size dt. Throws ModelError for a bad dt, DivergenceError (with the
   /// predicted stable dt) if the state became non-finite.
-  void step(double dt, int count = 1);
+  void step(double dt, int count = 1) override;
+
+  IntegratorKind kind() const override { return kind_; }
+  const char* name() const override { return "fast_explicit"; }
+  bool batches_steps() const override { return true; }
 
   int num_nodes() const;
   int num_springs() const;
@@ -83,6 +88,7 @@ class FastExplicitStepper {
 
  private:
   std::unique_ptr<Implementation> impl_;
+  IntegratorKind kind_;
 };
 
 }  // namespace msfem::massspring

@@ -60,10 +60,10 @@ class ForceModel {
   Eigen::SparseMatrix<double> dfdv(const Eigen::VectorXd& x) const;
 };
 
-/// A force a MassSpringModel holds beside its springs, gravity and nodal loads (volume
-/// preservation, tool contact, ...): a ForceModel over the model's nodes that also says which nodes
-/// it acts on and which of its coefficients a fit may scale. Fields are immutable once in a model
-/// (copies of the model share them); a changed field is a new one put in its place.
+/// One of the forces a MechanicalSystem sums (its springs, volume preservation, the tool's contact,
+/// ...): a ForceModel over the system's nodes that also says which nodes it acts on and which of
+/// its coefficients a fit may scale. Fields are immutable once in a model (copies of the model
+/// share them); a changed field is a new one put in its place.
 class ForceField : public ForceModel {
  public:
   /// The nodes whose forces this field sets, and the only ones whose x, v (and, in the products,

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
 #include "msfem/massspring/name_table.hpp"
 
 namespace msfem::massspring {
@@ -17,7 +17,7 @@ struct State {
 };
 
 /// The model's initial state: rest positions, constrained nodes at their targets, at rest.
-State initial_state(const MassSpringModel& model);
+State initial_state(const MechanicalSystem& model);
 
 enum class IntegratorKind {
   explicit_euler,      ///< x' = x + h v,  v' = v + h a(x, v)
@@ -61,14 +61,14 @@ class Integrator {
       : kind_(kind), implicit_(implicit) {}
 
   /// Throws ModelError if dt is not finite and > 0.
-  void step(const MassSpringModel& model, State& state, double dt);
+  void step(const MechanicalSystem& model, State& state, double dt);
 
   IntegratorKind kind() const { return kind_; }
   /// CG iterations used by the last implicit step (0 for explicit integrators).
   int last_cg_iterations() const { return last_cg_iterations_; }
 
  private:
-  void implicit_euler_step(const MassSpringModel& model, State& state, double dt);
+  void implicit_euler_step(const MechanicalSystem& model, State& state, double dt);
 
   IntegratorKind kind_;
   ImplicitOptions implicit_;

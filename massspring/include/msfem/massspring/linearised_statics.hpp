@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
 #include "msfem/massspring/static_solver.hpp"
 
 namespace msfem::massspring {
@@ -22,20 +22,20 @@ class TangentFactor;
 class LinearisedStatics {
  public:
   /// `parts[p]` is a per-spring stiffness vector (zero outside the part; anchors, if any, belong to
-  /// part 0, whose weight should stay 1); the model's constraints
-  /// (supports and the tool's prescribed patch) and loads are those of `model`. A model with
-  /// force fields (volume preservation) gets one more part per field, after the given ones and in
-  /// the model's field order, holding that field alone: its weight scales the field's Jacobian and
-  /// its force at rest (a field that pulls at rest, as a grasper does, is linear in its weight).
-  /// `factorization` makes the sparse Cholesky factor (empty: Eigen's SimplicialLDLT), as
-  /// StaticOptions::factorization.
-  LinearisedStatics(const MassSpringModel& model, const std::vector<Eigen::VectorXd>& parts,
+  /// part 0, whose weight should stay 1) of the system's springs (its SpringForceField); the
+  /// constraints (supports and the tool's prescribed patch) and loads are those of `model`. Each
+  /// of its other force fields (volume preservation, ...) is one more part, after the given ones
+  /// and in the system's field order, holding that field alone: its weight scales the field's
+  /// Jacobian and its force at rest (a field that pulls at rest, as a grasper does, is linear in
+  /// its weight). `factorization` makes the sparse Cholesky factor (empty: Eigen's SimplicialLDLT),
+  /// as StaticOptions::factorization.
+  LinearisedStatics(const MechanicalSystem& model, const std::vector<Eigen::VectorXd>& parts,
                     std::function<std::unique_ptr<SparseSpdFactor>()> factorization = {});
   ~LinearisedStatics();
   LinearisedStatics(const LinearisedStatics&) = delete;
   LinearisedStatics& operator=(const LinearisedStatics&) = delete;
 
-  /// The number of weights solve() takes: the parts, plus one per force field of the model.
+  /// The number of weights solve() takes: the parts, plus one per force field beside the springs.
   int num_parts() const { return static_cast<int>(jacobians_.size()); }
 
   struct Solution {
@@ -47,7 +47,7 @@ class LinearisedStatics {
   Solution solve(const std::vector<double>& weights, const std::vector<int>& patch);
 
  private:
-  const MassSpringModel& model_;
+  const MechanicalSystem& model_;
   std::vector<Eigen::SparseMatrix<double>> jacobians_;       ///< ∂f/∂x of each part, all dofs
   std::vector<Eigen::SparseMatrix<double>> free_stiffness_;  ///< −∂f/∂x of each part, free dofs
   std::vector<Eigen::VectorXd> free_load_;  ///< each part's force from the prescribed u, free dofs

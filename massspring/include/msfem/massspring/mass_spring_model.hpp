@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "msfem/massspring/force_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 #include "msfem/massspring/spring_network.hpp"
 #include "msfem/massspring/surface_contact.hpp"
@@ -15,20 +16,22 @@
 
 namespace msfem::massspring {
 
-/// A spring network with its loads and supports: the object a simulator embeds. As a ForceModel it
-/// is the sum of the springs (SpringForceField), gravity m_i g, external nodal forces and a list of
-/// named force fields (volume preservation, the tool's contact, ...). Supports are nodes whose
-/// position is prescribed (fixed = zero displacement); integrators and solvers hold them at their
-/// target and ignore their force rows. Parameters (k, d, m per group) can be changed between steps;
-/// nothing is rebuilt.
-class MassSpringModel : public ForceModel {
+/// A spring network with its loads and supports: the MechanicalSystem msfem builds and a simulator
+/// embeds. Its fields are the springs (a SpringForceField over its own network, always first) and
+/// then the fields added to it (volume preservation, the tool's contact, ...); its nodal loads are
+/// gravity m_i g and the external forces. Supports are nodes whose position is prescribed (fixed =
+/// zero displacement). Parameters (k, d, m per group) can be changed between steps; nothing is
+/// rebuilt.
+class MassSpringModel : public MechanicalSystem {
  public:
   /// Validates the network (throws ModelError) and fixes its `fixed_nodes`.
   explicit MassSpringModel(SpringNetwork network);
+  // A copy's springs field views the copy's own network.
+  MassSpringModel(const MassSpringModel& other);
+  MassSpringModel& operator=(const MassSpringModel& other);
 
   const SpringNetwork& network() const { return network_; }
-  int num_nodes() const { return network_.num_nodes(); }
-  SpringForceField springs() const { return SpringForceField(network_); }
+  const SpringForceField& springs() const { return *springs_; }
 
   // --- run-time parameters (the seed's menu) ---
   void set_group_stiffness(const std::string& spring_group, double stiffness);
@@ -52,31 +55,17 @@ class MassSpringModel : public ForceModel {
   void fix_node(int node) { prescribe_displacement(node, Eigen::Vector3d::Zero()); }
   void prescribe_displacement(int node, const Eigen::Vector3d& displacement);
   void release_node(int node);
-  bool is_constrained(int node) const { return constrained_[check_node(node, "node")]; }
-  std::vector<int> constrained_nodes() const;
+  bool is_constrained(int node) const override { return constrained_[check_node(node, "node")]; }
   /// Where a constrained node is held: rest position + prescribed displacement.
-  Eigen::Vector3d constrained_target(int node) const;
+  Eigen::Vector3d constrained_target(int node) const override;
 
-  // --- force fields beyond the springs, summed in list order, found by their type ---
-  using FieldList = std::vector<std::shared_ptr<const ForceField>>;
-  const FieldList& fields() const { return fields_; }
+  // --- force fields: the springs, then the fields added here, found by their type ---
+  const FieldList& fields() const override { return fields_; }
   /// Appends `field` to the list. Throws ModelError if it is not built for this model's nodes.
   void add_field(std::shared_ptr<const ForceField> field);
-  /// Puts `field` in the list's place `index` (a fitted copy of the field there, say).
+  /// Puts `field` in the list's place `index` (a fitted copy of the field there, say); the springs'
+  /// place is refused: they change through the parameters above.
   void replace_field(std::size_t index, std::shared_ptr<const ForceField> field);
-  /// The first field that is a `Field` (a class or an interface), or null.
-  template <class Field>
-  const Field* find_field() const {
-    const int index = field_index<Field>();
-    return index < 0 ? nullptr : dynamic_cast<const Field*>(fields_[index].get());
-  }
-  /// The list's place of the first field that is a `Field`, or -1.
-  template <class Field>
-  int field_index() const {
-    for (std::size_t i = 0; i < fields_.size(); ++i)
-      if (dynamic_cast<const Field*>(fields_[i].get())) return static_cast<int>(i);
-    return -1;
-  }
   /// Puts `field` in the place of the first field that is a `Field`, or appends it.
   template <class Field>
   void set_field(std::shared_ptr<const ForceField> field) {
@@ -86,14 +75,14 @@ class MassSpringModel : public ForceModel {
     else
       replace_field(static_cast<std::size_t>(index), std::move(field));
   }
-  /// Removes every field that is a `Field`.
+  /// Removes every field that is a `Field`, the model's springs aside.
   template <class Field>
   void clear_fields() {
-    for (int index = field_index<Field>(); index >= 0; index = field_index<Field>())
-      fields_.erase(fields_.begin() + index);
+    for (std::size_t i = fields_.size(); i-- > 1;)
+      if (dynamic_cast<const Field*>(fields_[i].get())) fields_.erase(fields_.begin() + i);
   }
-  /// The fields' names (ForceField::name), comma-separated, for messages.
-  std::string field_names() const;
+  /// True when fields beyond the springs were added.
+  bool has_added_fields() const { return fields_.size() > 1; }
 
   // --- the two fields msfem builds ---
   /// Tool contact (penalty, frictionless): nodes only, or the surface's triangles; replaces the
@@ -107,36 +96,14 @@ class MassSpringModel : public ForceModel {
   void clear_volume() { clear_fields<VolumeForceField>(); }
   const VolumeForceField* volume() const { return find_field<VolumeForceField>(); }
 
-  // --- ForceModel ---
-  int num_dofs() const override { return 3 * num_nodes(); }
-  void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                 Eigen::VectorXd& f) const override;
-  double potential_energy(const Eigen::VectorXd& x) const override;
-  void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                        const Eigen::VectorXd& dx, Eigen::VectorXd& df,
-                        Linearisation mode = Linearisation::exact) const override;
-  void add_dfdv_product(const Eigen::VectorXd& x, const Eigen::VectorXd& dv,
-                        Eigen::VectorXd& df) const override;
-  void add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Triplets& triplets,
-                         Linearisation mode = Linearisation::exact) const override;
-  void add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const override;
-
-  // --- state helpers ---
-  Eigen::VectorXd rest_state() const { return flatten(network_.rest_positions); }
-  /// Rest state with the constrained nodes at their targets.
-  Eigen::VectorXd initial_state() const;
-  /// Masses repeated per dof (the diagonal of the lumped mass matrix M).
-  Eigen::VectorXd mass_per_dof() const;
-  /// Puts constrained nodes at their targets with zero velocity.
-  void enforce_constraints(Eigen::VectorXd& x, Eigen::VectorXd& v) const;
-  /// Zeroes the constrained nodes' entries (the projection onto free dofs).
-  void zero_constrained(Eigen::VectorXd& vector) const;
-  /// a = M⁻¹ f(x, v) on free nodes, zero on constrained ones.
-  Eigen::VectorXd acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
-  double kinetic_energy(const Eigen::VectorXd& v) const;
-  double total_energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
-    return kinetic_energy(v) + potential_energy(x);
+  // --- MechanicalSystem ---
+  int num_nodes() const override { return network_.num_nodes(); }
+  Eigen::VectorXd rest_state() const override { return flatten(network_.rest_positions); }
+  const Eigen::VectorXd& masses() const override { return network_.masses; }
+  Eigen::Vector3d node_load(int node) const override {
+    return network_.masses[node] * gravity_ + external_force_.row(node).transpose();
   }
+
   /// Surface node displacements (rows in network().surface_nodes order).
   Eigen::MatrixX3d surface_displacement(const Eigen::VectorXd& x) const;
 
@@ -149,7 +116,8 @@ class MassSpringModel : public ForceModel {
   Eigen::MatrixX3d external_force_;
   std::vector<char> constrained_;
   Eigen::MatrixX3d prescribed_displacement_;
-  FieldList fields_;  ///< shared by copies: a field is immutable
+  std::shared_ptr<const SpringForceField> springs_;  ///< over network_, fields_[0]
+  FieldList fields_;  ///< beyond the springs shared by copies: a field is immutable
 };
 
 }  // namespace msfem::massspring

@@ -4,7 +4,8 @@
 
 #include <Eigen/Core>
 
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/spring_network.hpp"
 
 namespace msfem::massspring {
 
@@ -27,7 +28,7 @@ struct DampingFit {
   /// r reaches the target; the report says so.
   bool reachable = true;
 };
-DampingFit fit_damping(const MassSpringModel& model, const Eigen::VectorXd& x, double target,
+DampingFit fit_damping(const MechanicalSystem& model, const Eigen::VectorXd& x, double target,
                        const Eigen::VectorXd& shape = Eigen::VectorXd());
 
 }  // namespace msfem::massspring

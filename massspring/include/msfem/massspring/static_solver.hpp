@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/mechanical_system.hpp"
 
 namespace msfem::massspring {
 
@@ -100,7 +100,7 @@ struct StaticResult {
 /// one than with other options or another start, and an exactly symmetric problem can end on a
 /// symmetric saddle. Throws ModelError if the free dofs are unsupported (singular stiffness: add
 /// supports or anchors).
-StaticResult solve_static(const MassSpringModel& model, const StaticOptions& options = {},
+StaticResult solve_static(const MechanicalSystem& model, const StaticOptions& options = {},
                           const Eigen::VectorXd& start = Eigen::VectorXd());
 
 }  // namespace msfem::massspring

@@ -10,6 +10,7 @@
 namespace msfem::massspring {
 
 class MassSpringModel;
+class MechanicalSystem;
 
 /// A rigid spherical tool tip.
 struct SphereTool {
@@ -109,13 +110,13 @@ double stiffest_surface_node(const MassSpringModel& model);
 /// Force the tissue exerts on the tool (what a haptic device renders), at state x (statics, v = 0):
 /// with a prescribed patch, the sum over the patch of the internal and applied forces, which at
 /// equilibrium balance the tool's push; with penalty contact, minus the sum of contact forces.
-Eigen::Vector3d patch_reaction_force(const MassSpringModel& model, const Eigen::VectorXd& x,
+Eigen::Vector3d patch_reaction_force(const MechanicalSystem& model, const Eigen::VectorXd& x,
                                      const std::vector<int>& patch);
-Eigen::Vector3d contact_reaction_force(const MassSpringModel& model, const Eigen::VectorXd& x);
+Eigen::Vector3d contact_reaction_force(const MechanicalSystem& model, const Eigen::VectorXd& x);
 
 /// For dynamics: moves contact nodes inside the tool onto its surface (closest point) and removes
 /// their velocity component towards the centre. Returns the number of nodes projected.
 /// With a surface contact only the nodes are projected (a triangle's interior may stay inside).
-int project_out_of_tool(const MassSpringModel& model, Eigen::VectorXd& x, Eigen::VectorXd& v);
+int project_out_of_tool(const MechanicalSystem& model, Eigen::VectorXd& x, Eigen::VectorXd& v);
 
 }  // namespace msfem::massspring

@@ -1,4 +1,4 @@
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <sys/wait.h>

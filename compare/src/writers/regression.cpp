@@ -1,4 +1,4 @@
-#include "msfem/compare/pipeline/regression.hpp"
+#include "msfem/compare/writers/regression.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -9,7 +9,7 @@
 
 #include "msfem/compare/pipeline/content_hash.hpp"
 #include "msfem/compare/pipeline/fem_cache.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/writers/fields_h5.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 

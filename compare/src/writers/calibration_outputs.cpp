@@ -6,9 +6,9 @@
 
 #include "msfem/cases/network_file.hpp"
 #include "msfem/cases/setting_names.hpp"
-#include "msfem/compare/calibration/calibration_case.hpp"
-#include "msfem/compare/writers/atomic_file.hpp"
-#include "msfem/compare/writers/json_values.hpp"
+#include "msfem/compare/writers/calibration_outputs.hpp"
+#include "msfem/compare/pipeline/atomic_file.hpp"
+#include "msfem/compare/pipeline/json_values.hpp"
 #include "msfem/compare/writers/plots.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 #include "msfem/compare/writers/text_format.hpp"
