@@ -11,6 +11,7 @@
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/linearised_statics.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/topology_builders.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 
@@ -104,8 +105,8 @@ TEST(ForceFields, AFieldJoinsEveryForceModelCall) {
   const MassSpringModel springs_only = model;
   const double k = 40.0, c = 0.3;
   model.set_field<RestTether>(std::make_shared<RestTether>(rest, k, c));
-  ASSERT_EQ(model.fields().size(), 2u);
-  EXPECT_EQ(model.field_names(), "springs, tether");
+  ASSERT_EQ(model.fields().size(), 3u);
+  EXPECT_EQ(model.field_names(), "springs, nodal loads, tether");
 
   const Eigen::VectorXd extra = model.force(x, v) - springs_only.force(x, v);
   EXPECT_LT((extra + k * (x - rest) + c * v).norm(), 1e-9 * (k * (x - rest)).norm());
@@ -140,7 +141,7 @@ TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByType) {
                   static_cast<int>(nv.size()), 3, 500.0)));
   model.set_field<RestTether>(tether->scaled("tether", 3.0));
   ASSERT_EQ(model.field_names(),
-            "springs, tether, volume preservation");  // replaced where it was
+            "springs, nodal loads, tether, volume preservation");  // replaced where it was
   const MassSpringModel with_volume_only = [&] {
     MassSpringModel m = model;
     m.clear_fields<RestTether>();
@@ -151,46 +152,63 @@ TEST(ForceFields, ReplacedInPlaceScaledByGroupAndClearedByType) {
   EXPECT_THROW(tether->scaled("volume", 2.0), ModelError);
   EXPECT_THROW(model.add_field(std::make_shared<RestTether>(rest.head(6), 1.0, 0.0)), ModelError);
   // Copies share fields but not the list: clearing one copy's leaves the other's.
-  EXPECT_EQ(springs_only.fields().size(), 1u);
+  EXPECT_EQ(springs_only.fields().size(), 2u);
   EXPECT_NE(model.volume(), nullptr);
 }
 
-// The fast steppers step a model's fields as the generic integrators do (a tether with a dashpot:
-// it reads x and v): symplectic Euler on the explicit kernels, backward Euler on the implicit ones
-// with the tether's Jacobians. The linearised statics give each field its own weight.
-// The springs are the model's first field, over the model's own network: a copy's springs read
-// the copy's parameters, and the list refuses to lose or replace them.
-TEST(ForceFields, SpringsAreTheModelsFirstFieldOverItsOwnNetwork) {
+// The springs and the nodal loads are the model's first two fields, over the model's own network,
+// masses, gravity and external forces: a copy's read the copy's parameters, and the list refuses
+// to lose or replace them.
+TEST(ForceFields, SpringsAndLoadsAreTheModelsOwnFields) {
   const MassSpringModel model = three_tier_model();
   const Eigen::VectorXd rest = model.rest_state();
   const Eigen::VectorXd x = perturbed(rest, 0.002, 3), v = perturbed(0 * rest, 0.01, 4);
   ASSERT_EQ(model.field_index<SpringForceField>(), 0);
+  ASSERT_EQ(model.field_index<NodalLoadField>(), 1);
   EXPECT_EQ(&model.find_field<SpringForceField>()->network(), &model.network());
   const Eigen::VectorXd before = model.force(x, v);
 
   MassSpringModel stiffer = model;
   EXPECT_EQ(&stiffer.springs().network(), &stiffer.network());
   stiffer.scale_group_stiffness(stiffer.network().spring_group_names[0], 2.0);
-  EXPECT_EQ(model.force(x, v), before);  // the original's springs are untouched
+  const Eigen::Vector3d g(0.0, 0.0, -9.81), push(0.01, 0.0, 0.0);
+  stiffer.set_gravity(g);
+  stiffer.set_external_force(3, push);
+  EXPECT_EQ(model.force(x, v), before);  // the original's springs and loads are untouched
   EXPECT_GT((stiffer.force(x, v) - before).norm(), 1e-6 * before.norm());
+  EXPECT_EQ(stiffer.loads().load(3), stiffer.network().masses[3] * g + push);
+  EXPECT_EQ(model.loads().load(3), Eigen::Vector3d::Zero());
 
   MassSpringModel assigned = three_tier_model();
   assigned = stiffer;
   EXPECT_EQ(&assigned.springs().network(), &assigned.network());
   EXPECT_EQ(assigned.force(x, v), stiffer.force(x, v));
+  assigned.set_gravity(Eigen::Vector3d::Zero());
+  EXPECT_EQ(stiffer.loads().load(3), stiffer.network().masses[3] * g + push);
+  EXPECT_EQ(assigned.loads().load(3), push);
 
-  // The sum over the fields is the springs' force plus the loads when nothing else is added.
-  Eigen::VectorXd springs_only = Eigen::VectorXd::Zero(rest.size());
-  model.springs().add_force(x, v, springs_only);
-  for (int i = 0; i < model.num_nodes(); ++i)
-    springs_only.segment<3>(3 * i) += model.node_load(i);
-  EXPECT_LT((springs_only - before).norm(), 1e-14 * before.norm());
+  // The sum over the fields is the springs' force plus the loads when nothing else is added, and
+  // the loads' energy is -Σ f_i·x_i.
+  Eigen::VectorXd springs_and_loads = Eigen::VectorXd::Zero(rest.size());
+  stiffer.springs().add_force(x, v, springs_and_loads);
+  double load_energy = 0.0;
+  for (int i = 0; i < stiffer.num_nodes(); ++i) {
+    springs_and_loads.segment<3>(3 * i) += stiffer.loads().load(i);
+    load_energy -= stiffer.loads().load(i).dot(x.segment<3>(3 * i));
+  }
+  EXPECT_LT((springs_and_loads - stiffer.force(x, v)).norm(), 1e-14 * before.norm());
+  EXPECT_NEAR(stiffer.loads().potential_energy(x), load_energy, 1e-14 * std::abs(load_energy));
 
   stiffer.clear_fields<ForceField>();
-  EXPECT_EQ(stiffer.fields().size(), 1u);
-  EXPECT_THROW(stiffer.replace_field(0, std::make_shared<RestTether>(rest, 1.0, 0.0)), ModelError);
+  EXPECT_EQ(stiffer.fields().size(), 2u);
+  for (std::size_t own : {0u, 1u})
+    EXPECT_THROW(stiffer.replace_field(own, std::make_shared<RestTether>(rest, 1.0, 0.0)),
+                 ModelError);
 }
 
+// The fast steppers step a model's fields as the generic integrators do (a tether with a dashpot:
+// it reads x and v): symplectic Euler on the explicit kernels, backward Euler on the implicit ones
+// with the tether's Jacobians. The linearised statics give each field its own weight.
 TEST(ForceFields, FastSteppersStepFieldsAndLinearStaticsWeighEach) {
   MassSpringModel model = tethered_model();
   const Eigen::VectorXd rest = model.rest_state();

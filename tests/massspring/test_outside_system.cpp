@@ -17,6 +17,7 @@
 #include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/mechanical_system.hpp"
 #include "msfem/massspring/modal_damping.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/static_solver.hpp"
 #include "msfem/massspring/stepper.hpp"
@@ -29,16 +30,19 @@ using testing::Grasper;
 using testing::icosphere;
 
 // A simulator's own system: its network held by value, the nodes inside `held_radius` fixed at
-// rest, a uniform downward load per node, and its fields in the order it chose.
+// rest, a uniform load per node, and its fields in the order it chose.
 class SimulatorSystem : public MechanicalSystem {
  public:
-  SimulatorSystem(SpringNetwork network, double held_radius, Eigen::Vector3d load)
-      : network_(std::move(network)), load_(load) {
-    for (int i = 0; i < network_.num_nodes(); ++i)
+  SimulatorSystem(SpringNetwork network, double held_radius, const Eigen::Vector3d& load)
+      : network_(std::move(network)), forces_(network_.num_nodes(), 3) {
+    for (int i = 0; i < network_.num_nodes(); ++i) {
       held_.push_back(network_.rest_positions.row(i).norm() < held_radius);
+      forces_.row(i) = load.transpose();
+    }
     fields_.push_back(std::make_shared<const SpringForceField>(network_));
+    fields_.push_back(std::make_shared<const NodalLoadField>(network_.masses, gravity_, forces_));
   }
-  SimulatorSystem(const SimulatorSystem&) = delete;  // the springs field views network_
+  SimulatorSystem(const SimulatorSystem&) = delete;  // its fields view its members
 
   void add(std::shared_ptr<const ForceField> field) { fields_.push_back(std::move(field)); }
   const SpringNetwork& network() const { return network_; }
@@ -50,13 +54,13 @@ class SimulatorSystem : public MechanicalSystem {
   Eigen::Vector3d constrained_target(int node) const override {
     return network_.rest_positions.row(node).transpose();
   }
-  Eigen::Vector3d node_load(int) const override { return load_; }
   const FieldList& fields() const override { return fields_; }
 
  private:
   SpringNetwork network_;
   std::vector<bool> held_;
-  Eigen::Vector3d load_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
+  Eigen::MatrixX3d forces_;
   FieldList fields_;
 };
 
@@ -181,7 +185,6 @@ class GraspOnly : public MechanicalSystem {
   const Eigen::VectorXd& masses() const override { return masses_; }
   bool is_constrained(int) const override { return false; }
   Eigen::Vector3d constrained_target(int) const override { return Eigen::Vector3d::Zero(); }
-  Eigen::Vector3d node_load(int) const override { return Eigen::Vector3d::Zero(); }
   const FieldList& fields() const override { return fields_; }
   Eigen::VectorXd rest_ = Eigen::VectorXd::Zero(6);
 

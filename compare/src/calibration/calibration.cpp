@@ -272,7 +272,9 @@ class GroupFit {
     for (int g = 0; g < n_; ++g)
       weights[g + 1] = std::exp(theta[g]);
     for (std::size_t f = 0; f < base_.model->fields().size(); ++f) {
-      if (base_.model->fields()[f].get() == &base_.model->springs()) continue;  // the parts above
+      // The springs are weighed by the parts above, the loads by none.
+      const ms::ForceField* field = base_.model->fields()[f].get();
+      if (field == &base_.model->springs() || field == &base_.model->loads()) continue;
       double weight = 1.0;
       for (int g = 0; g < n_; ++g)
         if (field_of_[g] == static_cast<int>(f)) weight = factor_at(theta, g);

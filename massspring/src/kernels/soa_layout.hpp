@@ -20,6 +20,7 @@
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 #include "node_ordering.hpp"
 
@@ -59,8 +60,11 @@ struct SoaLayout {
     set_state(model, initial_state(model));
   }
 
+  // The springs and the nodal loads (folded into each node's constant term) are the kernels' own;
+  // the steppers take every other field through its ForceField calls.
   void load_parameters(const MechanicalSystem& model) {
     const SpringNetwork& net = spring_field(model, "the fast stepper").network();
+    const auto* loads = model.find_field<NodalLoadField>();
     if (net.num_nodes() != num_nodes || net.num_springs() != num_springs)
       throw ModelError(
           "fast stepper: model topology changed (nodes or springs); build a new stepper");
@@ -101,7 +105,7 @@ struct SoaLayout {
       node_damping[i] = static_cast<Real>(net.node_damping[old] + anchor_c[old]);
       anchor_stiffness[i] = static_cast<Real>(anchor_k[old]);
       // Relative: the anchor's -k_a (X + u - p) as the load's k_a (p - X) and -k_a u.
-      const Eigen::Vector3d node_load = model.node_load(old);
+      const Eigen::Vector3d node_load = loads ? loads->load(old) : Eigen::Vector3d::Zero();
       for (int c = 0; c < 3; ++c)
         load[c][i] =
             static_cast<Real>(node_load[c] + anchor_kp(old, c) - anchor_k[old] * frame_at(c, i));

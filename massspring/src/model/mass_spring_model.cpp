@@ -24,14 +24,14 @@ void check_non_negative(double value, const std::string& item) {
 
 MassSpringModel::MassSpringModel(SpringNetwork network) : network_(std::move(network)) {
   network_.validate();
-  springs_ = std::make_shared<const SpringForceField>(network_);
-  fields_.push_back(springs_);
+  fields_.resize(own_fields);
   const int n = network_.num_nodes();
   external_force_ = Eigen::MatrixX3d::Zero(n, 3);
   prescribed_displacement_ = Eigen::MatrixX3d::Zero(n, 3);
   constrained_.assign(n, 0);
   for (int node : network_.fixed_nodes)
     fix_node(node);
+  bind_own_fields();
 }
 
 MassSpringModel::MassSpringModel(const MassSpringModel& other)
@@ -40,9 +40,8 @@ MassSpringModel::MassSpringModel(const MassSpringModel& other)
       external_force_(other.external_force_),
       constrained_(other.constrained_),
       prescribed_displacement_(other.prescribed_displacement_),
-      springs_(std::make_shared<const SpringForceField>(network_)),
       fields_(other.fields_) {
-  fields_[0] = springs_;
+  bind_own_fields();
 }
 
 MassSpringModel& MassSpringModel::operator=(const MassSpringModel& other) {
@@ -52,10 +51,16 @@ MassSpringModel& MassSpringModel::operator=(const MassSpringModel& other) {
   external_force_ = other.external_force_;
   constrained_ = other.constrained_;
   prescribed_displacement_ = other.prescribed_displacement_;
-  springs_ = std::make_shared<const SpringForceField>(network_);
   fields_ = other.fields_;
-  fields_[0] = springs_;
+  bind_own_fields();
   return *this;
+}
+
+void MassSpringModel::bind_own_fields() {
+  springs_ = std::make_shared<const SpringForceField>(network_);
+  loads_ = std::make_shared<const NodalLoadField>(network_.masses, gravity_, external_force_);
+  fields_[0] = springs_;
+  fields_[1] = loads_;
 }
 
 int MassSpringModel::check_node(int node, const char* what) const {
@@ -191,10 +196,11 @@ void MassSpringModel::replace_field(std::size_t index, std::shared_ptr<const For
   if (index >= fields_.size())
     throw ModelError("force field " + std::to_string(index) + ": the model has " +
                      std::to_string(fields_.size()));
-  if (index == 0)
-    throw ModelError(
-        "force field 0 is the model's springs: change them through its stiffness, "
-        "damping and mass parameters");
+  if (index < own_fields)
+    throw ModelError("force field " + std::to_string(index) + " is the model's " +
+                     fields_[index]->name() +
+                     ": change it through the model's stiffness, damping, mass and load "
+                     "parameters");
   check_field(field.get(), num_nodes());
   fields_[index] = std::move(field);
 }

@@ -13,16 +13,12 @@ void MechanicalSystem::add_force(const Eigen::VectorXd& x, const Eigen::VectorXd
                                  Eigen::VectorXd& f) const {
   for (const auto& field : fields())
     field->add_force(x, v, f);
-  for (int i = 0; i < num_nodes(); ++i)
-    f.segment<3>(3 * i) += node_load(i);
 }
 
 double MechanicalSystem::potential_energy(const Eigen::VectorXd& x) const {
   double energy = 0.0;
   for (const auto& field : fields())
     energy += field->potential_energy(x);
-  for (int i = 0; i < num_nodes(); ++i)
-    energy -= node_load(i).dot(x.segment<3>(3 * i));
   return energy;
 }
 

@@ -14,6 +14,7 @@
 #include "kernels/soa_layout.hpp"
 #include "kernels/thread_team.hpp"
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/stability.hpp"
 
 namespace msfem::massspring {
@@ -205,8 +206,9 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     fields_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_.num_nodes), 0);
     const ForceField* springs = &spring_field(model, "the fast stepper");
+    const ForceField* loads = model.find_field<NodalLoadField>();
     for (const auto& field : model.fields()) {
-      if (field.get() == springs) continue;  // the kernels' own
+      if (field.get() == springs || field.get() == loads) continue;  // the kernels' own
       fields_.push_back(field);
       for (int node : field->nodes())
         used[static_cast<std::size_t>(node)] = 1;

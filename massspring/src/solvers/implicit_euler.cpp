@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "msfem/massspring/integrators.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring {
@@ -33,11 +34,15 @@ Eigen::VectorXd jacobi_diagonal(const MechanicalSystem& model, const State& stat
   Eigen::VectorXd diagonal(3 * nodes);
   for (int i = 0; i < nodes; ++i)
     diagonal.segment<3>(3 * i).setConstant(per_node[i]);
-  if (model.fields().size() == (springs ? 1u : 0u)) return diagonal;
-  std::vector<Eigen::Matrix3d> blocks(static_cast<std::size_t>(nodes), Eigen::Matrix3d::Zero());
+  // The nodal loads are constant: no blocks.
+  const ForceField* loads = model.find_field<NodalLoadField>();
+  std::vector<const ForceField*> others;
   for (const auto& field : model.fields())
-    if (field.get() != springs)
-      field->add_diagonal_blocks(state.x, state.v, -h * h, -h, blocks, Linearisation::definite);
+    if (field.get() != springs && field.get() != loads) others.push_back(field.get());
+  if (others.empty()) return diagonal;
+  std::vector<Eigen::Matrix3d> blocks(static_cast<std::size_t>(nodes), Eigen::Matrix3d::Zero());
+  for (const ForceField* field : others)
+    field->add_diagonal_blocks(state.x, state.v, -h * h, -h, blocks, Linearisation::definite);
   for (int i = 0; i < nodes; ++i)
     diagonal.segment<3>(3 * i) += blocks[static_cast<std::size_t>(i)].diagonal();
   return diagonal;

@@ -15,6 +15,7 @@
 
 #include "kernels/node_gather_layout.hpp"
 #include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring::detail {
@@ -33,8 +34,9 @@ class ImplicitFields {
     tangents_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
     const ForceField* springs = &spring_field(model, "the fast stepper");
+    const ForceField* loads = model.find_field<NodalLoadField>();
     for (const auto& field : model.fields()) {
-      if (field.get() == springs) continue;  // the kernels' own
+      if (field.get() == springs || field.get() == loads) continue;  // the kernels' own
       fields_.push_back(field);
       tangents_.push_back(field->tangent(x_, v_, Linearisation::definite));
       for (int node : field->nodes())

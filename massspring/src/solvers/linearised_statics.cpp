@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 
 #include "static_linear.hpp"
@@ -19,9 +20,10 @@ LinearisedStatics::LinearisedStatics(
   const Eigen::VectorXd rest = model.rest_state();
   const Eigen::VectorXd still = Eigen::VectorXd::Zero(n);
   const SpringForceField& springs = spring_field(model, "the linearised statics");
+  const ForceField* loads = model.find_field<NodalLoadField>();  // in rest_force_, unweighted
   std::vector<const ForceField*> fields;
   for (const auto& field : model.fields())
-    if (field.get() != &springs) fields.push_back(field.get());
+    if (field.get() != &springs && field.get() != loads) fields.push_back(field.get());
   field_rest_force_.resize(parts.size() + fields.size());
   auto jacobian = [&](const ForceField& part) {
     Triplets t;

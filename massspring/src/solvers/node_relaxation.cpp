@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring::detail {
@@ -33,6 +34,7 @@ NodeRelaxation::NodeRelaxation(const MechanicalSystem& model) : model_(model) {
   // Without springs (a system of other fields alone) only the nodewise fields are relaxed here.
   static const SpringNetwork no_springs;
   springs_field_ = model.find_field<SpringForceField>();
+  loads_ = model.find_field<NodalLoadField>();
   network_ = springs_field_ ? &springs_field_->network() : &no_springs;
   const SpringNetwork& net = *network_;
   const int nodes = model.num_nodes();
@@ -48,7 +50,7 @@ NodeRelaxation::NodeRelaxation(const MechanicalSystem& model) : model_(model) {
   left_to_newton_.assign(static_cast<std::size_t>(nodes), 0);
   std::vector<std::pair<int, const ForceField*>> terms;
   for (const auto& field : model.fields()) {
-    if (field.get() == springs_field_) continue;
+    if (field.get() == springs_field_ || field.get() == loads_) continue;
     for (int i : field->nodes())
       if (field->nodewise())
         terms.emplace_back(i, field.get());
@@ -66,7 +68,7 @@ NodeRelaxation::NodeRelaxation(const MechanicalSystem& model) : model_(model) {
 double NodeRelaxation::local(const Eigen::VectorXd& x, int i, const Eigen::Vector3d& p,
                              Eigen::Vector3d* force, Eigen::Matrix3d* stiffness) const {
   const SpringNetwork& net = *network_;
-  const Eigen::Vector3d load = model_.node_load(i);
+  const Eigen::Vector3d load = loads_ ? loads_->load(i) : Eigen::Vector3d::Zero();
   const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
   double energy = -load.dot(p);
   Eigen::Vector3d f = load;

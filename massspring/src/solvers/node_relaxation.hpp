@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 
 namespace msfem::massspring::detail {
@@ -37,6 +38,7 @@ class NodeRelaxation {
   const MechanicalSystem& model_;
   const SpringForceField* springs_field_ = nullptr;  // the system's springs, if it has them
   const SpringNetwork* network_ = nullptr;           // theirs, or an empty one
+  const NodalLoadField* loads_ = nullptr;            // relaxed first, as each node's load
   std::vector<int> spring_start_, springs_;          // springs at each node (CSR)
   std::vector<int> anchor_start_, anchors_;          // anchors at each node (CSR)
   std::vector<int> node_term_start_, node_term_;     // nodewise fields' terms at each node (CSR)

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 #include "msfem/massspring/tool_contact.hpp"
 
@@ -19,8 +20,10 @@ class UnloadedSystem : public MechanicalSystem {
  public:
   explicit UnloadedSystem(const MechanicalSystem& system)
       : system_(system), springs_(system.find_field<SpringForceField>()) {
+    const ForceField* loads = system.find_field<NodalLoadField>();
     for (const auto& field : system.fields())
-      if (!dynamic_cast<const ToolContact*>(field.get())) fields_.push_back(field);
+      if (field.get() != loads && !dynamic_cast<const ToolContact*>(field.get()))
+        fields_.push_back(field);
   }
   int num_nodes() const override { return system_.num_nodes(); }
   Eigen::VectorXd rest_state() const override { return system_.rest_state(); }
@@ -29,7 +32,6 @@ class UnloadedSystem : public MechanicalSystem {
   Eigen::Vector3d constrained_target(int node) const override {
     return system_.constrained_target(node);
   }
-  Eigen::Vector3d node_load(int) const override { return Eigen::Vector3d::Zero(); }
   const FieldList& fields() const override { return fields_; }
 
   // The springs' energy where there are springs (the energy a run away oscillation feeds), the

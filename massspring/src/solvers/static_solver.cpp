@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "node_relaxation.hpp"
 #include "static_linear.hpp"
 
@@ -234,9 +235,10 @@ LineSearchResult line_search(const MechanicalSystem& model, const FreeDofs& dofs
 // |f_free| of the applied loads (gravity, external forces) and of the initial state, whose
 // larger is the scale of the problem: neither depends on where Newton starts.
 double reference_norm(const MechanicalSystem& model, const FreeDofs& dofs) {
+  const auto* loads = model.find_field<NodalLoadField>();
   double load_norm_squared = 0.0;
   for (int i = 0; i < model.num_nodes(); ++i)
-    if (!model.is_constrained(i)) load_norm_squared += model.node_load(i).squaredNorm();
+    if (loads && !model.is_constrained(i)) load_norm_squared += loads->load(i).squaredNorm();
   const Eigen::VectorXd x0 = model.initial_state();
   const double initial = dofs.gather(model.force(x0, Eigen::VectorXd::Zero(x0.size()))).norm();
   return std::max(std::sqrt(load_norm_squared), initial);

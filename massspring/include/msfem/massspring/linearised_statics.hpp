@@ -23,19 +23,20 @@ class LinearisedStatics {
  public:
   /// `parts[p]` is a per-spring stiffness vector (zero outside the part; anchors, if any, belong to
   /// part 0, whose weight should stay 1) of the system's springs (its SpringForceField); the
-  /// constraints (supports and the tool's prescribed patch) and loads are those of `model`. Each
-  /// of its other force fields (volume preservation, ...) is one more part, after the given ones
-  /// and in the system's field order, holding that field alone: its weight scales the field's
-  /// Jacobian and its force at rest (a field that pulls at rest, as a grasper does, is linear in
-  /// its weight). `factorization` makes the sparse Cholesky factor (empty: Eigen's SimplicialLDLT),
-  /// as StaticOptions::factorization.
+  /// constraints (supports and the tool's prescribed patch) and loads (its NodalLoadField) are
+  /// those of `model`. Each of its other force fields (volume preservation, ...) is one more part,
+  /// after the given ones and in the system's field order, holding that field alone: its weight
+  /// scales the field's Jacobian and its force at rest (a field that pulls at rest, as a grasper
+  /// does, is linear in its weight). `factorization` makes the sparse Cholesky factor (empty:
+  /// Eigen's SimplicialLDLT), as StaticOptions::factorization.
   LinearisedStatics(const MechanicalSystem& model, const std::vector<Eigen::VectorXd>& parts,
                     std::function<std::unique_ptr<SparseSpdFactor>()> factorization = {});
   ~LinearisedStatics();
   LinearisedStatics(const LinearisedStatics&) = delete;
   LinearisedStatics& operator=(const LinearisedStatics&) = delete;
 
-  /// The number of weights solve() takes: the parts, plus one per force field beside the springs.
+  /// The number of weights solve() takes: the parts, plus one per force field beside the springs
+  /// and the loads.
   int num_parts() const { return static_cast<int>(jacobians_.size()); }
 
   struct Solution {

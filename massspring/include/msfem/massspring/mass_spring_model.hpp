@@ -8,6 +8,7 @@
 
 #include "msfem/massspring/force_model.hpp"
 #include "msfem/massspring/mechanical_system.hpp"
+#include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/spring_force_field.hpp"
 #include "msfem/massspring/spring_network.hpp"
 #include "msfem/massspring/surface_contact.hpp"
@@ -17,11 +18,11 @@
 namespace msfem::massspring {
 
 /// A spring network with its loads and supports: the MechanicalSystem msfem builds and a simulator
-/// embeds. Its fields are the springs (a SpringForceField over its own network, always first) and
-/// then the fields added to it (volume preservation, the tool's contact, ...); its nodal loads are
-/// gravity m_i g and the external forces. Supports are nodes whose position is prescribed (fixed =
-/// zero displacement). Parameters (k, d, m per group) can be changed between steps; nothing is
-/// rebuilt.
+/// embeds. Its fields are the springs (a SpringForceField over its own network, always first), the
+/// nodal loads (a NodalLoadField over its masses, gravity and external forces, always second) and
+/// then the fields added to it (volume preservation, the tool's contact, ...). Supports are nodes
+/// whose position is prescribed (fixed = zero displacement). Parameters (k, d, m per group) and
+/// loads can be changed between steps; nothing is rebuilt.
 class MassSpringModel : public MechanicalSystem {
  public:
   /// Validates the network (throws ModelError) and fixes its `fixed_nodes`.
@@ -32,6 +33,7 @@ class MassSpringModel : public MechanicalSystem {
 
   const SpringNetwork& network() const { return network_; }
   const SpringForceField& springs() const { return *springs_; }
+  const NodalLoadField& loads() const { return *loads_; }
 
   // --- run-time parameters (the seed's menu) ---
   void set_group_stiffness(const std::string& spring_group, double stiffness);
@@ -59,12 +61,12 @@ class MassSpringModel : public MechanicalSystem {
   /// Where a constrained node is held: rest position + prescribed displacement.
   Eigen::Vector3d constrained_target(int node) const override;
 
-  // --- force fields: the springs, then the fields added here, found by their type ---
+  // --- force fields: the springs, the loads, then the fields added here, found by type ---
   const FieldList& fields() const override { return fields_; }
   /// Appends `field` to the list. Throws ModelError if it is not built for this model's nodes.
   void add_field(std::shared_ptr<const ForceField> field);
   /// Puts `field` in the list's place `index` (a fitted copy of the field there, say); the springs'
-  /// place is refused: they change through the parameters above.
+  /// and the loads' places are refused: they change through the parameters above.
   void replace_field(std::size_t index, std::shared_ptr<const ForceField> field);
   /// Puts `field` in the place of the first field that is a `Field`, or appends it.
   template <class Field>
@@ -75,14 +77,14 @@ class MassSpringModel : public MechanicalSystem {
     else
       replace_field(static_cast<std::size_t>(index), std::move(field));
   }
-  /// Removes every field that is a `Field`, the model's springs aside.
+  /// Removes every field that is a `Field`, the model's springs and loads aside.
   template <class Field>
   void clear_fields() {
-    for (std::size_t i = fields_.size(); i-- > 1;)
+    for (std::size_t i = fields_.size(); i-- > own_fields;)
       if (dynamic_cast<const Field*>(fields_[i].get())) fields_.erase(fields_.begin() + i);
   }
-  /// True when fields beyond the springs were added.
-  bool has_added_fields() const { return fields_.size() > 1; }
+  /// True when fields beyond the springs and the loads were added.
+  bool has_added_fields() const { return fields_.size() > own_fields; }
 
   // --- the two fields msfem builds ---
   /// Tool contact (penalty, frictionless): nodes only, or the surface's triangles; replaces the
@@ -100,9 +102,6 @@ class MassSpringModel : public MechanicalSystem {
   int num_nodes() const override { return network_.num_nodes(); }
   Eigen::VectorXd rest_state() const override { return flatten(network_.rest_positions); }
   const Eigen::VectorXd& masses() const override { return network_.masses; }
-  Eigen::Vector3d node_load(int node) const override {
-    return network_.masses[node] * gravity_ + external_force_.row(node).transpose();
-  }
 
   /// Surface node displacements (rows in network().surface_nodes order).
   Eigen::MatrixX3d surface_displacement(const Eigen::VectorXd& x) const;
@@ -116,8 +115,12 @@ class MassSpringModel : public MechanicalSystem {
   Eigen::MatrixX3d external_force_;
   std::vector<char> constrained_;
   Eigen::MatrixX3d prescribed_displacement_;
+  static constexpr std::size_t own_fields = 2;  ///< the springs and the loads
+  void bind_own_fields();  ///< the springs and the loads over this model's members
+
   std::shared_ptr<const SpringForceField> springs_;  ///< over network_, fields_[0]
-  FieldList fields_;  ///< beyond the springs shared by copies: a field is immutable
+  std::shared_ptr<const NodalLoadField> loads_;      ///< over masses, gravity_, external_force_
+  FieldList fields_;  ///< beyond the first two shared by copies: a field is immutable
 };
 
 }  // namespace msfem::massspring

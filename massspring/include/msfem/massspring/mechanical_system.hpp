@@ -10,10 +10,11 @@
 namespace msfem::massspring {
 
 /// What every solver sees of a model: n nodes with lumped masses, supports (nodes held at a
-/// target), constant nodal loads and a list of force fields summed in order. The springs are one
-/// field among the others; a solver that has a faster path for a field finds it by its type
-/// (find_field<SpringForceField>) and treats every other field through ForceField's calls alone.
-/// MassSpringModel is the implementation msfem builds; a simulator may bring its own.
+/// target) and a list of force fields summed in order. The springs and the nodal loads (gravity,
+/// external forces) are fields like the others; a solver that has a faster path for a field finds
+/// it by its type (find_field<SpringForceField>, find_field<NodalLoadField>) and treats every
+/// other field through ForceField's calls alone. MassSpringModel is the implementation msfem
+/// builds; a simulator may bring its own.
 class MechanicalSystem : public ForceModel {
  public:
   using FieldList = std::vector<std::shared_ptr<const ForceField>>;
@@ -28,8 +29,6 @@ class MechanicalSystem : public ForceModel {
   virtual bool is_constrained(int node) const = 0;
   /// Where a constrained node is held.
   virtual Eigen::Vector3d constrained_target(int node) const = 0;
-  /// The constant force on a node (gravity and external loads), N: U = -Σ load_i·x_i.
-  virtual Eigen::Vector3d node_load(int node) const = 0;
   /// Every force field, summed in this order.
   virtual const FieldList& fields() const = 0;
 
@@ -50,7 +49,7 @@ class MechanicalSystem : public ForceModel {
   /// The fields' names (ForceField::name), comma-separated, for messages.
   std::string field_names() const;
 
-  // --- ForceModel: the fields in list order, then the nodal loads ---
+  // --- ForceModel: the fields summed in list order ---
   int num_dofs() const override { return 3 * num_nodes(); }
   void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                  Eigen::VectorXd& f) const override;
