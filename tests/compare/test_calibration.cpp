@@ -45,8 +45,8 @@ std::vector<CalibrationLoad> synthetic_references(
     BuiltVariant v = build_variant(cases::Variant::three_tier, truth, no_mesh, r.tool);
     if (dress) dress(v);
     const StaticSolution s = solve_variant_static(v);
-    r.surface_displacement = s.surface_displacement;
-    r.tool_force = s.tool_force;
+    r.fem.surface_displacement = s.surface_displacement;
+    r.fem.tool_force = s.tool_force;
     for (Eigen::Index vertex = 0; vertex < truth.surface.num_vertices(); ++vertex)
       if (std::find(v.tool_patch.begin(), v.tool_patch.end(), vertex) == v.tool_patch.end() &&
           !truth.fixed_region(truth.surface.vertices.row(vertex).transpose()))
@@ -83,9 +83,10 @@ CalibrationFit expect_recovers(const cases::CaseParameters& p,
     EXPECT_NEAR(fit.groups[g].case_factor / truth[g], 1.0, 0.01) << groups[g];
     EXPECT_NEAR(fit.groups[g].factor * options.start_factors[g] / truth[g], 1.0, 0.01) << groups[g];
   }
-  EXPECT_GT(fit.before.train[0].rel_l2_error, 0.05);
-  EXPECT_LT(fit.after.train[0].rel_l2_error, 1e-3);
-  EXPECT_LT(fit.after.test[0].rel_l2_error, 1e-3);  // the held-out load: the truth generalises
+  EXPECT_GT(fit.before.train[0].displacement.all.rel_l2_error, 0.05);
+  EXPECT_LT(fit.after.train[0].displacement.all.rel_l2_error, 1e-3);
+  EXPECT_LT(fit.after.test[0].displacement.all.rel_l2_error,
+            1e-3);  // the held-out load: the truth generalises
   EXPECT_LT(fit.after.test[0].reaction_force_rel_error, 1e-3);
   EXPECT_LT(fit.objective_after, 1e-4 * fit.objective_before);
   EXPECT_EQ(fit.history.size(), static_cast<std::size_t>(fit.evaluations));
@@ -147,8 +148,8 @@ TEST(Calibration, FitsTheCoefficientGroupOfAFieldWrittenOutsideMassspring) {
   EXPECT_EQ(fit.groups[0].springs, 1);
   EXPECT_NEAR(fit.groups[0].factor / 2.5, 1.0, 0.01);
   EXPECT_NEAR(fit.groups[0].fitted_stiffness_n_per_m / 40.0, 1.0, 0.01);
-  EXPECT_GT(fit.before.train[0].rel_l2_error, 0.02);
-  EXPECT_LT(fit.after.test[0].rel_l2_error, 1e-3);
+  EXPECT_GT(fit.before.train[0].displacement.all.rel_l2_error, 0.02);
+  EXPECT_LT(fit.after.test[0].displacement.all.rel_l2_error, 1e-3);
   // The linearised fit weighs the field as one part, and finds the same k where the loads are
   // small enough for the model linearised at rest.
   const auto small = synthetic_references(problem, {5e-5, 5e-5, 5e-5}, add_grasper(40.0, 3e-5));
@@ -257,9 +258,10 @@ void expect_linear_agrees_and_recovers(cases::CaseParameters p,
   const CalibrationFit linear =
       calibrate(problem, {}, cases::Variant::three_tier, refs, {}, options);
   for (std::size_t i = 0; i < refs.size(); ++i) {
-    EXPECT_GT(newton.before.train[i].rel_l2_error, 0.02);
+    EXPECT_GT(newton.before.train[i].displacement.all.rel_l2_error, 0.02);
     // |e_lin − e_newton| ≤ ‖u_lin − u_newton‖ / ‖u_ref‖: the two fields agree to half a percent.
-    EXPECT_NEAR(linear.before.train[i].rel_l2_error, newton.before.train[i].rel_l2_error, 0.005);
+    EXPECT_NEAR(linear.before.train[i].displacement.all.rel_l2_error,
+                newton.before.train[i].displacement.all.rel_l2_error, 0.005);
     EXPECT_NEAR(linear.before.train[i].reaction_force_rel_error,
                 newton.before.train[i].reaction_force_rel_error, 0.005);
   }

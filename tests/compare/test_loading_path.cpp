@@ -55,6 +55,33 @@ TEST(LoadingPath, AFrictionlessToolStepsAtMostAQuarterOfItsRadius) {
   EXPECT_EQ(path_step_of(tool), 0.0);
 }
 
+// run, sweep and calibrate press every load along one rule: the case's curve depths, scaled to the
+// load's depth (quarters of it by default), in steps no longer than the path step.
+TEST(LoadingPath, EveryLoadFollowsTheCasesCurveScaledToItsDepth) {
+  cases::ToolParameters tool;
+  tool.mode = cases::ToolParameters::Mode::prescribed;
+  tool.depth_m = 0.004;
+  // The case's own depth: the default quarters, as the force-depth curve records them.
+  EXPECT_EQ(loading_path(tool, 0.004), loading_path(curve_depths(tool), 0.004, 0.0));
+  EXPECT_EQ(loading_path(tool, 0.002), (std::vector<double>{0.0005, 0.001, 0.0015, 0.002}));
+  tool.curve_depths_m = {0.002, 0.006};
+  EXPECT_EQ(loading_path(tool, 0.004), (std::vector<double>{0.002, 0.004, 0.006}));
+  const std::vector<double> half = loading_path(tool, 0.002);
+  ASSERT_EQ(half.size(), 3u);
+  EXPECT_DOUBLE_EQ(half[0], 0.001);
+  EXPECT_EQ(half[1], 0.002);  // the load's own depth exactly, where its equilibrium is read
+  EXPECT_DOUBLE_EQ(half[2], 0.003);
+  // A frictionless tool of radius 2 mm: no step over half a millimetre.
+  tool.mode = cases::ToolParameters::Mode::contact;
+  tool.radius_m = 0.002;
+  double last = 0.0;
+  for (double d : loading_path(tool, 0.002)) {
+    EXPECT_LE(d - last, 0.0005 + 1e-15);
+    last = d;
+  }
+  EXPECT_EQ(last, 0.003);
+}
+
 BuiltVariant one_tetrahedron() {
   Eigen::MatrixX3d v(4, 3);
   v << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;

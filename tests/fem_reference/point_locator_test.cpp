@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "msfem/fem_reference/closest_point.hpp"
 #include "msfem/fem_reference/elasticity_problem.hpp"
 #include "msfem/fem_reference/shape_mesher.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
@@ -95,6 +96,34 @@ TEST(PointLocator, EvaluatesAQuadraticFieldInP2AtArbitraryPoints) {
     EXPECT_LT((u.row(i).transpose() - exact(points.row(i).transpose())).norm(), 1e-12) << i;
   // A point between a curved boundary's facets is clamped to the nearest cell.
   EXPECT_TRUE(problem.displacements_at(Eigen::RowVector3d(0, 0, 1.0)).allFinite());
+}
+
+// Each of the seven Voronoi regions of a right triangle, against the closest point by hand; and
+// random points against a dense sampling of the triangle.
+TEST(ClosestPointOnTriangle, EveryRegionGivesTheClosedFormAndNoSampleIsCloser) {
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const auto at = [&](double x, double y, double z) {
+    return closest_point_on_triangle(Eigen::Vector3d(x, y, z), a, b, c);
+  };
+  EXPECT_LT((at(0.2, 0.3, 1) - Eigen::Vector3d(0.2, 0.3, 0)).norm(), 1e-15);  // face
+  EXPECT_EQ(at(-1, -1, 0.5), a);
+  EXPECT_EQ(at(2, -1, 0), b);
+  EXPECT_EQ(at(-0.5, 3, -1), c);
+  EXPECT_LT((at(0.5, -1, 3) - Eigen::Vector3d(0.5, 0, 0)).norm(), 1e-15);    // edge ab
+  EXPECT_LT((at(-1, 0.25, 0) - Eigen::Vector3d(0, 0.25, 0)).norm(), 1e-15);  // edge ac
+  EXPECT_LT((at(1, 1, 2) - Eigen::Vector3d(0.5, 0.5, 0)).norm(), 1e-15);     // edge bc
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-1.5, 1.5);
+  const Eigen::Vector3d b2(0.8, 0.3, 0.4), c2(-0.2, 0.9, -0.3);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+    const double closest = (closest_point_on_triangle(p, a, b2, c2) - p).norm();
+    for (int i = 0; i <= 40; ++i)
+      for (int j = 0; i + j <= 40; ++j) {
+        const Eigen::Vector3d q = a + (b2 - a) * (i / 40.0) + (c2 - a) * (j / 40.0);
+        ASSERT_LE(closest, (q - p).norm() + 1e-12);
+      }
+  }
 }
 
 }  // namespace

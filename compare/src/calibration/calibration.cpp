@@ -54,10 +54,10 @@ bool is_converged(nlopt::result r) {
          r == nlopt::XTOL_REACHED;
 }
 
-double objective_of(const std::vector<LoadErrors>& errors, double force_weight) {
+double objective_of(const std::vector<CalibrationErrors>& errors, double force_weight) {
   double sum = 0;
   for (const auto& e : errors)
-    sum += e.rel_l2_error * e.rel_l2_error +
+    sum += e.displacement.all.rel_l2_error * e.displacement.all.rel_l2_error +
            force_weight * e.reaction_force_rel_error * e.reaction_force_rel_error;
   return sum / static_cast<double>(errors.size());
 }
@@ -84,24 +84,16 @@ int nodes_in_contact(const BuiltVariant& variant, const Eigen::VectorXd& x) {
   return count;
 }
 
-LoadErrors errors_against(const CalibrationLoad& reference, const Eigen::MatrixX3d& displacement,
-                          const Eigen::Vector3d& force, const BuiltVariant& variant,
-                          const Eigen::VectorXd& x = {}) {
-  LoadErrors e;
+// The errors msfem run measures (tet_edges on the FEM's tool-refined mesh has more surface nodes;
+// the case's come first), with the nodes under the tool.
+CalibrationErrors errors_against(const Problem& problem, const CalibrationLoad& reference,
+                                 const Eigen::MatrixX3d& displacement, const Eigen::Vector3d& force,
+                                 const BuiltVariant& variant, const Eigen::VectorXd& x = {}) {
+  CalibrationErrors e;
+  static_cast<LoadErrors&>(e) = load_errors(problem, reference, displacement, force);
   e.load = reference.load.label();
   e.tool_patch_nodes = variant.tool_patch.empty() ? nodes_in_contact(variant, x)
                                                   : static_cast<int>(variant.tool_patch.size());
-  // tet_edges on the FEM's tool-refined mesh has more surface nodes; the case's come first.
-  const Eigen::Index n = reference.surface_displacement.rows();
-  if (displacement.rows() < n)
-    throw std::invalid_argument("displacement fields differ in size: " +
-                                std::to_string(displacement.rows()) + " vs " + std::to_string(n));
-  const ErrorMetrics m = displacement_error(displacement.topRows(n), reference.surface_displacement,
-                                            reference.compared_vertices);
-  e.rel_l2_error = m.rel_l2_error;
-  e.mean_error_over_max_disp = m.mean_error_over_max_disp;
-  e.tool_force = force;
-  e.reaction_force_rel_error = reaction_force_rel_error(force, reference.tool_force);
   return e;
 }
 
@@ -113,39 +105,38 @@ LoadModels models_for(const BuiltVariant& base, const std::vector<CalibrationLoa
     v.model = std::make_unique<ms::MassSpringModel>(*base.model);
     v.tool_patch = base.tool_patch;
     v.case_surface_vertices = base.case_surface_vertices;
-    set_tool_depth(v, r.tool);
+    set_tool_depth(v, r.placement());
     m.variants.push_back(std::move(v));
     m.x.emplace_back();
   }
   return m;
 }
 
-// The load's equilibrium as msfem run reaches it. A frictionless tool's equilibrium need not be
-// unique (the shell can turn under an oblique load, or slide off a tool placed at full depth at
-// once): it is pressed from rest along quarters of its depth (finer with the case's path step),
-// each from the last. A bonded patch is solved from rest at its depth.
+// The load's equilibrium as msfem run reaches it, along the one loading path: an equilibrium
+// need not be unique (the shell can turn under an oblique load, a frictionless tool placed at full
+// depth at once can slide off), and the path picks the branch a simulator's tool pressed in steps
+// follows.
 StaticSolution equilibrium_from_rest(BuiltVariant& variant, const CalibrationLoad& reference,
-                                     double path_step) {
-  const double d = reference.tool.depth;
-  return press(variant, reference.tool,
-               variant.model->contact() ? loading_path({0.25 * d, 0.5 * d, 0.75 * d}, d, path_step)
-                                        : std::vector<double>{d});
+                                     const cases::ToolParameters& tool) {
+  return press(variant, reference.tool, loading_path(tool, reference.placement().depth));
 }
 
 // The load's equilibrium from `x`, or from rest as msfem run reaches it when `x` is empty.
 StaticSolution equilibrium(BuiltVariant& variant, const CalibrationLoad& reference,
-                           const Eigen::VectorXd& x, double path_step) {
-  if (x.size() == 0) return equilibrium_from_rest(variant, reference, path_step);
-  set_tool_depth(variant, reference.tool);
+                           const Eigen::VectorXd& x, const cases::ToolParameters& tool) {
+  if (x.size() == 0) return equilibrium_from_rest(variant, reference, tool);
+  set_tool_depth(variant, reference.placement());
   return solve_variant_static(variant, x);
 }
 
 // A field at its place in the model's list.
 using PlacedField = std::pair<std::size_t, std::shared_ptr<const ms::ForceField>>;
 
-std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<CalibrationLoad>& references,
-                                     const Eigen::VectorXd& stiffness,
-                                     const std::vector<PlacedField>& fields, double path_step) {
+std::vector<CalibrationErrors> evaluate_all(LoadModels& m,
+                                            const std::vector<CalibrationLoad>& references,
+                                            const Eigen::VectorXd& stiffness,
+                                            const std::vector<PlacedField>& fields,
+                                            const Problem& problem) {
   return shared_errors(references.size(), [&](std::size_t i) {
     m.variants[i].model->set_stiffness(stiffness);
     for (const auto& [place, field] : fields)
@@ -153,10 +144,12 @@ std::vector<LoadErrors> evaluate_all(LoadModels& m, const std::vector<Calibratio
     // A frictionless tool's penalty is picked from the stiffness, as msfem run picks it for the
     // fitted model.
     m.variants[i].contact_pressure_penalty = 0.0;
-    const StaticSolution s = equilibrium(m.variants[i], references[i],
-                                         m.from_rest ? Eigen::VectorXd() : m.x[i], path_step);
+    const StaticSolution s =
+        equilibrium(m.variants[i], references[i], m.from_rest ? Eigen::VectorXd() : m.x[i],
+                    problem.parameters.loads.tool);
     m.x[i] = s.x;
-    return errors_against(references[i], s.surface_displacement, s.tool_force, m.variants[i], s.x);
+    return errors_against(problem, references[i], s.surface_displacement, s.tool_force,
+                          m.variants[i], s.x);
   });
 }
 
@@ -261,11 +254,11 @@ class GroupFit {
     return m;
   }
 
-  std::vector<LoadErrors> evaluate(LoadModels& m, const std::vector<CalibrationLoad>& references,
-                                   const std::vector<double>& theta) const {
+  std::vector<CalibrationErrors> evaluate(LoadModels& m,
+                                          const std::vector<CalibrationLoad>& references,
+                                          const std::vector<double>& theta) const {
     if (!options_.linear)
-      return evaluate_all(m, references, stiffness_at(theta), fields_at(theta),
-                          path_step_of(problem_.parameters.loads.tool));
+      return evaluate_all(m, references, stiffness_at(theta), fields_at(theta), problem_);
     // Parts: the unfitted springs, each fitted spring group, and each field (LinearisedStatics
     // puts them last); a field group's own spring part stays empty.
     std::vector<double> weights(n_ + 1, 1.0);
@@ -282,7 +275,8 @@ class GroupFit {
     }
     return shared_errors(references.size(), [&](std::size_t i) {
       const auto s = m.linear[i]->solve(weights, m.variants[i].tool_patch);
-      return errors_against(references[i], s.surface_displacement, s.patch_force, m.variants[i]);
+      return errors_against(problem_, references[i], s.surface_displacement, s.patch_force,
+                            m.variants[i]);
     });
   }
 
@@ -424,19 +418,20 @@ void optimise(const std::function<double(const std::vector<double>&)>& j, BestPo
 
 }  // namespace
 
-LoadErrors evaluate_load(BuiltVariant& variant, const CalibrationLoad& reference,
-                         Eigen::VectorXd& x, double path_step) {
-  const StaticSolution s = equilibrium(variant, reference, x, path_step);
+CalibrationErrors evaluate_load(const Problem& problem, BuiltVariant& variant,
+                                const CalibrationLoad& reference, Eigen::VectorXd& x) {
+  const StaticSolution s = equilibrium(variant, reference, x, problem.parameters.loads.tool);
   x = s.x;
-  return errors_against(reference, s.surface_displacement, s.tool_force, variant, s.x);
+  return errors_against(problem, reference, s.surface_displacement, s.tool_force, variant, s.x);
 }
 
-LoadErrors evaluate_load_linear(BuiltVariant& variant, const CalibrationLoad& reference) {
-  set_tool_depth(variant, reference.tool);
+CalibrationErrors evaluate_load_linear(const Problem& problem, BuiltVariant& variant,
+                                       const CalibrationLoad& reference) {
+  set_tool_depth(variant, reference.placement());
   ms::LinearisedStatics statics(*variant.model, {variant.model->network().stiffness},
                                 cholmod_factorization());
   const auto s = statics.solve(std::vector<double>(statics.num_parts(), 1.0), variant.tool_patch);
-  return errors_against(reference, s.surface_displacement, s.patch_force, variant);
+  return errors_against(problem, reference, s.surface_displacement, s.patch_force, variant);
 }
 
 CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh& mesh,
@@ -451,8 +446,8 @@ CalibrationFit calibrate(const Problem& problem, const fem_reference::VolumeMesh
                          const std::vector<CalibrationLoad>& test,
                          const CalibrationOptions& options) {
   if (train.empty()) throw_empty_training(problem);
-  return calibrate(problem, build_variant(variant, problem, mesh, train.front().tool), train, test,
-                   options);
+  return calibrate(problem, build_variant(variant, problem, mesh, train.front().placement()), train,
+                   test, options);
 }
 
 CalibrationFit calibrate(const Problem& problem, const BuiltVariant& base,

@@ -157,12 +157,9 @@ void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& tr
   c.fem_from_cache = references.from_cache;
   for (std::size_t i = 0; i < all.size(); ++i) {
     LoadReference& fem = references.loads[i];
-    CalibrationLoad load{all[i],
-                         *fem.tool,
-                         std::move(fem.fem.surface_displacement),
-                         fem.fem.tool_force,
-                         std::move(fem.compared_vertices),
-                         fem.fem_error};
+    CalibrationLoad load;
+    static_cast<LoadReference&>(load) = std::move(fem);
+    load.load = all[i];
     (i < train.size() ? c.train : c.test).push_back(std::move(load));
   }
   c.fem_time_s = seconds_since(start);
@@ -172,10 +169,10 @@ void solve_references(CaseCalibration& c, const std::vector<cases::ToolLoad>& tr
 void note_unresolved_loads(CaseCalibration& c) {
   std::string list;
   auto check = [&](const std::vector<CalibrationLoad>& references,
-                   const std::vector<LoadErrors>& errors) {
+                   const std::vector<CalibrationErrors>& errors) {
     for (std::size_t i = 0; i < references.size() && i < errors.size(); ++i) {
       const LoadErrorEstimate& e = references[i].fem_error;
-      if (within_reference_error(errors[i].rel_l2_error, e.rel_l2_error) ||
+      if (within_reference_error(errors[i].displacement.all.rel_l2_error, e.rel_l2_error) ||
           within_reference_error(errors[i].reaction_force_rel_error, e.force_rel_error))
         list += (list.empty() ? "" : ", ") + references[i].load.label();
     }
@@ -212,23 +209,23 @@ std::string group_scales_assignment(const std::vector<std::pair<std::string, dou
 }
 
 VariantOnTest mean_on(const std::string& name, bool calibrated,
-                      const std::vector<LoadErrors>& errors) {
+                      const std::vector<CalibrationErrors>& errors) {
   VariantOnTest v{name, calibrated, 0.0, 0.0};
   for (const auto& e : errors) {
-    v.mean_rel_l2_error += e.rel_l2_error / errors.size();
+    v.mean_rel_l2_error += e.displacement.all.rel_l2_error / errors.size();
     v.mean_reaction_force_rel_error += e.reaction_force_rel_error / errors.size();
   }
   return v;
 }
 
-// Below this many tool nodes the report warns (see LoadErrors::tool_patch_nodes).
+// Below this many tool nodes the report warns (see CalibrationErrors::tool_patch_nodes).
 constexpr int min_tool_patch_nodes = 3;
 
 // "load (N nodes), ..." for every training or held-out load whose tool patch is that small.
 std::string loads_with_few_tool_nodes(const ErrorsOnLoads& errors) {
   std::string list;
   for (const auto* set : {&errors.train, &errors.test})
-    for (const LoadErrors& e : *set)
+    for (const CalibrationErrors& e : *set)
       if (e.tool_patch_nodes < min_tool_patch_nodes)
         list += (list.empty() ? "" : ", ") + e.load + " (" + std::to_string(e.tool_patch_nodes) +
                 (e.tool_patch_nodes == 1 ? " node)" : " nodes)");
@@ -323,21 +320,21 @@ void state_calibrated_case(CaseCalibration& c, const cases::CaseParameters& para
   c.calibrated_overrides.push_back(group_scales_assignment(written_scales));
   BuiltVariant built = build_variant(c.variant, calibrated, c.mesh, c.train.front().tool);
   Eigen::VectorXd x;
-  const LoadErrors check =
-      evaluate_load(built, c.train.front(), x, path_step_of(c.problem.parameters.loads.tool));
+  const CalibrationErrors check = evaluate_load(c.problem, built, c.train.front(), x);
   c.nonlinear_check = check;
   if (c.options.linear)
     c.notes.push_back(
         "the fit used the spring model linearised at rest; the nonlinear model (as "
         "msfem run solves it) with the fitted values gives rel_l2_error " +
-        std::to_string(check.rel_l2_error) + " and reaction_force_rel_error " +
+        std::to_string(check.displacement.all.rel_l2_error) + " and reaction_force_rel_error " +
         std::to_string(check.reaction_force_rel_error) + " on " + check.load);
-  else if (std::abs(check.rel_l2_error - c.fit.after.train.front().rel_l2_error) >
-           1e-6 * std::max(1.0, check.rel_l2_error))
+  else if (std::abs(check.displacement.all.rel_l2_error -
+                    c.fit.after.train.front().displacement.all.rel_l2_error) >
+           1e-6 * std::max(1.0, check.displacement.all.rel_l2_error))
     c.notes.push_back("calibrated.prm re-solved gives rel_l2_error " +
-                      std::to_string(check.rel_l2_error) + " on " + check.load +
+                      std::to_string(check.displacement.all.rel_l2_error) + " on " + check.load +
                       " where the fit had " +
-                      std::to_string(c.fit.after.train.front().rel_l2_error));
+                      std::to_string(c.fit.after.train.front().displacement.all.rel_l2_error));
   // The mode that settles after a press: the static deflection under the first training load.
   c.damping = massspring::fit_damping(*built.model, x, c.target_damping_ratio,
                                       x - built.model->initial_state());
@@ -377,14 +374,12 @@ void compare_on_held_out_loads(CaseCalibration& c, const cases::CaseParameters& 
       const std::string& name = spec.name;
       progress.stage("held-out loads on " + name + " (as the case has it) for comparison");
       BuiltVariant other = build_variant(spec, c.problem, c.mesh, c.test.front().tool);
-      std::vector<LoadErrors> errors;
+      std::vector<CalibrationErrors> errors;
       try {
         for (const auto& r : c.test) {
           Eigen::VectorXd xo;
-          errors.push_back(
-              c.options.linear
-                  ? evaluate_load_linear(other, r)
-                  : evaluate_load(other, r, xo, path_step_of(c.problem.parameters.loads.tool)));
+          errors.push_back(c.options.linear ? evaluate_load_linear(c.problem, other, r)
+                                            : evaluate_load(c.problem, other, r, xo));
         }
       } catch (const std::runtime_error& e) {
         // A comparison only: say so and go on, the calibration itself stands.

@@ -13,9 +13,9 @@ namespace msfem::compare {
 namespace {
 
 template <typename Io, typename E>
-void error_fields(Io& io, E& e) {  // LoadErrors
-  io.io(e.load), io.io(e.rel_l2_error), io.io(e.mean_error_over_max_disp);
-  io.io(e.reaction_force_rel_error), io.io(e.tool_force), io.io(e.tool_patch_nodes);
+void error_fields(Io& io, E& e) {  // CalibrationErrors
+  detail::load_error_fields(io, e);
+  io.io(e.load), io.io(e.tool_patch_nodes);
 }
 
 }  // namespace
@@ -24,9 +24,9 @@ bool owns_load(std::size_t i) {
   return static_cast<int>(i % static_cast<std::size_t>(ranks::count())) == ranks::index();
 }
 
-std::vector<LoadErrors> shared_errors(std::size_t loads,
-                                      const std::function<LoadErrors(std::size_t)>& one) {
-  std::vector<LoadErrors> errors(loads);
+std::vector<CalibrationErrors> shared_errors(
+    std::size_t loads, const std::function<CalibrationErrors(std::size_t)>& one) {
+  std::vector<CalibrationErrors> errors(loads);
   if (ranks::count() == 1) {
     for (std::size_t i = 0; i < loads; ++i)
       errors[i] = one(i);
@@ -38,7 +38,7 @@ std::vector<LoadErrors> shared_errors(std::size_t loads,
     if (!owns_load(i)) continue;
     long long index = static_cast<long long>(i);
     try {
-      LoadErrors e = one(i);
+      CalibrationErrors e = one(i);
       char failed = 0;
       own.io(index), own.io(failed), error_fields(own, e);
     } catch (const std::exception& e) {

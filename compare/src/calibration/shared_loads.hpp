@@ -19,8 +19,8 @@ bool owns_load(std::size_t i);
 /// fails the evaluation on every rank (the first such load's failure, as a cases::InputError if it
 /// was one, else as a std::runtime_error), so that no rank waits in a collective the others have
 /// left.
-std::vector<LoadErrors> shared_errors(std::size_t loads,
-                                      const std::function<LoadErrors(std::size_t)>& one);
+std::vector<CalibrationErrors> shared_errors(
+    std::size_t loads, const std::function<CalibrationErrors(std::size_t)>& one);
 
 /// Every load's equilibrium on every rank, from `mine`, where the loads this rank owns are set.
 std::vector<Eigen::VectorXd> shared_equilibria(const std::vector<Eigen::VectorXd>& mine);

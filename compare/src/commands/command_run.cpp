@@ -49,10 +49,8 @@ int run_command(const Arguments& args) {
     failed = run.failed_variants;
     if (!work_dir) return;
     for (const auto& v : run.variants)
-      for (const auto& w : v.warnings)
-        if (w.find(buckling_warning_start) != std::string::npos ||
-            w.find(lost_tool_warning_start) != std::string::npos)
-          buckled.push_back(v.name + ": " + w);
+      for (const Warning& w : v.warnings)
+        if (w.under_tool()) buckled.push_back(v.name + ": " + w.written());
     write_run_outputs(run, *work_dir);
     if (opt.flag("json")) {
       printed << summary_json(run).dump(2) << '\n';

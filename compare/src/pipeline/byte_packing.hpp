@@ -119,6 +119,20 @@ struct Writer {
     p.put(v);
   }
 };
+// The structures more than one result carries: a load's errors (run's and calibrate's alike).
+template <typename Io, typename M>
+void error_metric_fields(Io& io, M& m) {  // ErrorMetrics
+  io.io(m.rel_l2_error), io.io(m.rms_error_m), io.io(m.max_error_m);
+  io.io(m.mean_error_over_max_disp), io.io(m.vertices);
+}
+
+template <typename Io, typename E>
+void load_error_fields(Io& io, E& e) {  // LoadErrors
+  error_metric_fields(io, e.displacement.all), error_metric_fields(io, e.displacement.contact_zone);
+  error_metric_fields(io, e.displacement.far_field);
+  io.io(e.tool_force), io.io(e.force_measured), io.io(e.reaction_force_rel_error);
+}
+
 struct Reader {
   Unpacker u;
   template <typename T>

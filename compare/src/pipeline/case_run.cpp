@@ -65,7 +65,7 @@ std::optional<std::string> buckling_warning(const std::vector<ForceDepthPoint>& 
   const double allowed = std::max(0.5, fem_fraction + lateral_fraction_margin);
   const BucklingOnset onset = buckling_onset(curve, tool, allowed);
   if (!onset.force_falls_at_m && !onset.turns_sideways_at_m) return std::nullopt;
-  std::string why = std::string(buckling_warning_start) + ":";
+  std::string why = "buckles under the tool:";
   if (onset.force_falls_at_m)
     why += " from " + millimetres(*onset.force_falls_at_m) + " of " + millimetres(tool.depth) +
            " the reaction force stops growing with depth;";
@@ -173,25 +173,27 @@ void warn_at_load(const CaseRun& run, long long tetrahedra, std::size_t load, Va
   if (reference.tool)
     if (auto warning =
             buckling_warning(result.force_depth, *reference.tool, reference.fem, tetrahedra))
-      r.warnings.push_back((load == 0 ? "" : "at tool " + std::to_string(load) + ": ") + *warning);
+      r.warnings.push_back({Warning::Kind::buckling, std::move(*warning), load});
   if (reference.tool && result.lost_tool) {
     char text[320];
-    std::snprintf(text, sizeof text,
-                  "%s: at %.3g mm it pushes back with %.3g N where the FEM does with %.3g N (its "
-                  "surface gave way or slid off the sphere): its force is no answer",
-                  lost_tool_warning_start, 1e3 * reference.tool->depth, result.tool_force.norm(),
-                  reference.fem.tool_force.norm());
-    r.warnings.push_back((load == 0 ? "" : "at tool " + std::to_string(load) + ": ") +
-                         std::string(text));
+    std::snprintf(
+        text, sizeof text,
+        "loses the tool: at %.3g mm it pushes back with %.3g N where the FEM does with %.3g N (its "
+        "surface gave way or slid off the sphere): its force is no answer",
+        1e3 * reference.tool->depth, result.tool_force.norm(), reference.fem.tool_force.norm());
+    r.warnings.push_back({Warning::Kind::lost_tool, text, load});
   }
   if (load != 0) return;
+  const std::vector<Metric> metrics = unresolved_metrics(run, result, load);
+  if (metrics.empty()) return;
   std::string unresolved;
-  for (const Metric metric : unresolved_metrics(run, result, load))
+  for (const Metric metric : metrics)
     unresolved += (unresolved.empty() ? "" : ", ") + std::string(metric_name(metric));
-  if (!unresolved.empty())
-    r.warnings.push_back("not resolved by this reference: " + unresolved +
-                         " within 3x of the FEM's own estimated error (a finer fem/cell "
-                         "size resolves it)");
+  r.warnings.push_back({Warning::Kind::unresolved_metrics,
+                        "not resolved by this reference: " + unresolved +
+                            " within 3x of the FEM's own estimated error (a finer fem/cell "
+                            "size resolves it)",
+                        load, metrics});
 }
 
 VariantResult variant_header(const BuiltVariant& built) {
@@ -284,6 +286,28 @@ void run_variants(CaseRun& run, const std::vector<double>& path, const RunSettin
 
 }  // namespace
 
+LoadErrors load_errors(const Problem& problem, const LoadReference& reference,
+                       const Eigen::MatrixX3d& surface_displacement,
+                       const std::optional<Eigen::Vector3d>& tool_force) {
+  const FemSolution& fem = reference.fem;
+  const std::optional<ToolPlacement>& tool = reference.tool;
+  const Eigen::Index n = fem.surface_displacement.rows();
+  if (surface_displacement.rows() < n)
+    throw std::invalid_argument(
+        "displacement fields differ in size: " + std::to_string(surface_displacement.rows()) +
+        " vs " + std::to_string(n) + " vertices");
+  LoadErrors e;
+  e.displacement = zoned_displacement_error(
+      surface_displacement.topRows(n), fem.surface_displacement, problem.surface.vertices,
+      reference.compared_vertices, tool ? tool->contact_point : problem.centroid,
+      tool ? 2 * tool->radius : 0.0);
+  e.force_measured = tool_force.has_value();
+  if (tool_force) e.tool_force = *tool_force;
+  if (tool && tool_force)
+    e.reaction_force_rel_error = reaction_force_rel_error(*tool_force, fem.tool_force);
+  return e;
+}
+
 ToolLoadVariant measure_at_load(const Problem& problem, const std::string& name,
                                 const Eigen::MatrixX3d& surface_displacement,
                                 const std::optional<Eigen::Vector3d>& tool_force,
@@ -291,17 +315,9 @@ ToolLoadVariant measure_at_load(const Problem& problem, const std::string& name,
   const FemSolution& fem = load.fem;
   const std::optional<ToolPlacement>& tool = load.tool;
   ToolLoadVariant o;
+  static_cast<LoadErrors&>(o) = load_errors(problem, load, surface_displacement, tool_force);
   o.name = name;
-  o.errors = zoned_displacement_error(surface_displacement, fem.surface_displacement,
-                                      problem.surface.vertices, load.compared_vertices,
-                                      tool ? tool->contact_point : problem.centroid,
-                                      tool ? 2 * tool->radius : 0.0);
-  o.force_measured = tool_force.has_value();
-  if (tool_force) o.tool_force = *tool_force;
-  if (tool && tool_force) {
-    o.lost_tool = lost_the_tool(*tool_force, fem.tool_force, *tool);
-    o.reaction_force_rel_error = reaction_force_rel_error(*tool_force, fem.tool_force);
-  }
+  if (tool && tool_force) o.lost_tool = lost_the_tool(*tool_force, fem.tool_force, *tool);
   o.volume_change = volume_change(problem.surface, surface_displacement);
   o.force_depth_monotone = force_grows_with_depth(curve, tool);
   o.force_depth = std::move(curve);
@@ -366,6 +382,17 @@ double path_step_of(const cases::ToolParameters& tool) {
   return step > 0 ? std::min(step, limit) : limit;
 }
 
+std::vector<double> loading_path(const cases::ToolParameters& tool, double depth) {
+  std::vector<double> depths = {0.25 * depth, 0.5 * depth, 0.75 * depth, depth};
+  if (!tool.curve_depths_m.empty()) {
+    depths = tool.curve_depths_m;
+    if (depth != tool.depth_m)
+      for (double& d : depths)
+        d *= depth / tool.depth_m;
+  }
+  return loading_path(std::move(depths), depth, path_step_of(tool));
+}
+
 std::optional<double> force_depth_exponent(const std::vector<ForceDepthPoint>& curve,
                                            const std::optional<ToolPlacement>& tool) {
   if (!tool || curve.size() < 2) return std::nullopt;
@@ -427,9 +454,7 @@ CaseRun run_case(const cases::CaseParameters& parameters, const RunSettings& set
   // One loading path whatever a command writes: --no-curve skips the FEM's curve and the curves'
   // output, never the path the variants are pressed along (their equilibria would differ).
   const std::vector<double> path =
-      tool ? loading_path(curve_depths(parameters.loads.tool), tool->depth,
-                          path_step_of(parameters.loads.tool))
-           : std::vector<double>{};
+      tool ? loading_path(parameters.loads.tool, tool->depth) : std::vector<double>{};
   if (ranks::count() > 1)
     detail::run_variants_across_ranks(run, path, settings, progress);
   else
@@ -462,7 +487,7 @@ std::vector<Metric> unresolved_metrics(const CaseRun& run, const ToolLoadVariant
   std::vector<Metric> metrics;
   if (load >= run.loads.size()) return metrics;
   const LoadErrorEstimate& estimate = run.loads[load].fem_error;
-  if (within_reference_error(variant.errors.all.rel_l2_error, estimate.rel_l2_error))
+  if (within_reference_error(variant.displacement.all.rel_l2_error, estimate.rel_l2_error))
     metrics.push_back(Metric::rel_l2_error);
   if (run.loads[load].tool &&
       within_reference_error(variant.reaction_force_rel_error, estimate.force_rel_error))

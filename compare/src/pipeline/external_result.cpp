@@ -206,8 +206,8 @@ std::vector<VariantResult> external_variants(const CaseRun& run) {
       v.loads.push_back(measure_at_load(run.problem, r.name, a.surface_displacement, a.tool_force,
                                         std::move(a.curve), run.loads[k]));
       if (run.loads[k].tool && !a.tool_force)
-        v.warnings.push_back((k == 0 ? "" : "at tool " + std::to_string(k) + ": ") +
-                             std::string("no tool force given: the force columns are empty"));
+        v.warnings.push_back(
+            {Warning::Kind::no_tool_force, "no tool force given: the force columns are empty", k});
     }
     results.push_back(std::move(v));
   }

@@ -212,12 +212,15 @@ void build_network_variant(BuiltVariant& variant, const Problem& problem) {
   // Xsp's scene-wide values: the case's loads and damping apply to every variant alike.
   const Eigen::Vector3d& g = p.loads.gravity_m_per_s2;
   if (!n.gravity.isZero() && (n.gravity - g).norm() > 1e-9 * std::max(g.norm(), n.gravity.norm()))
-    variant.warnings.push_back("the file's grav " + point_text(n.gravity) +
-                               " m/s^2 is not applied: the case's loads/gravity " + point_text(g) +
-                               " is, as for every variant");
+    variant.warnings.push_back({Warning::Kind::file_setting_not_applied,
+                                "the file's grav " + point_text(n.gravity) +
+                                    " m/s^2 is not applied: the case's loads/gravity " +
+                                    point_text(g) + " is, as for every variant"});
   if (n.viscosity && *n.viscosity != 0)
-    variant.warnings.push_back("the file's visc (" + std::to_string(*n.viscosity) +
-                               ") is not applied: dampers come from mass spring/damping ratio");
+    variant.warnings.push_back(
+        {Warning::Kind::file_setting_not_applied,
+         "the file's visc (" + std::to_string(*n.viscosity) +
+             ") is not applied: dampers come from mass spring/damping ratio"});
 }
 
 void check_networks_fit(const Problem& problem) {

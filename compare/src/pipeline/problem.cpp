@@ -15,6 +15,7 @@
 #include "msfem/cases/surface_simplification.hpp"
 #include "msfem/cases/surface_validation.hpp"
 #include "msfem/cases/units.hpp"
+#include "msfem/fem_reference/closest_point.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
 
 namespace msfem::compare {
@@ -117,29 +118,6 @@ ToolPlacement place_tool(const cases::CaseParameters& p, const cases::Surface& s
   return t;
 }
 
-/// The point of the triangle (a, b, c) closest to x (Ericson, Real-Time Collision Detection, 5.1.5).
-Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
-                                          const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = x - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Eigen::Vector3d bp = x - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-  const Eigen::Vector3d cp = x - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-  const double denominator = 1.0 / (va + vb + vc);
-  return a + ab * vb * denominator + ac * vc * denominator;
-}
-
 /// The closest approach of the surface to `center`.
 double distance_to_surface(const cases::Surface& s, const Eigen::Vector3d& center) {
   return (closest_surface_point(s, center).point - center).norm();
@@ -154,7 +132,7 @@ SurfacePoint closest_surface_point(const cases::Surface& s, const Eigen::Vector3
     const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)).transpose();
     const Eigen::Vector3d b = s.vertices.row(s.triangles(t, 1)).transpose();
     const Eigen::Vector3d c = s.vertices.row(s.triangles(t, 2)).transpose();
-    const Eigen::Vector3d q = closest_point_on_triangle(x, a, b, c);
+    const Eigen::Vector3d q = fem_reference::closest_point_on_triangle(x, a, b, c);
     const double d = (q - x).squaredNorm();
     if (!(d < nearest)) continue;
     nearest = d;

@@ -80,7 +80,7 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   pt.surface_vertices = static_cast<int>(run.problem.surface.num_vertices());
   pt.nodes = v.nodes;
   pt.springs = v.springs;
-  pt.rel_l2_error = at_load.errors.all.rel_l2_error;
+  pt.rel_l2_error = at_load.displacement.all.rel_l2_error;
   pt.reaction_force_rel_error = at_load.reaction_force_rel_error;
   pt.stable_dt_s = t.stable_dt_s;
   pt.steps_per_second = t.steps_per_second;

@@ -89,9 +89,11 @@ void set_volume_preservation(BuiltVariant& variant, const Problem& problem) {
   // The brain's offset inner tiers fold where the surface is concave: such prisms are inverted or
   // flat at rest, and with them Newton stalled (residual ~1e-7 N after 100 iterations).
   if (const int removed = ms::remove_degenerate_elements(elements, rest, 1e-3); removed > 0)
-    variant.warnings.push_back(
-        "volume preservation: " + std::to_string(removed) + " of " + std::to_string(all) +
-        " volume elements are inverted or flat at rest (folded tiers, slivers) and are left out");
+    variant.warnings.push_back({Warning::Kind::degenerate_volume_elements,
+                                "volume preservation: " + std::to_string(removed) + " of " +
+                                    std::to_string(all) +
+                                    " volume elements are inverted or flat at rest (folded tiers, "
+                                    "slivers) and are left out"});
   if (problem.youngs_modulus_image)
     variant.youngs_modulus_range.include(ms::apply_modulus_field(
         elements, rest, youngs_modulus_field(problem), p.material.youngs_modulus_pa));
@@ -213,7 +215,8 @@ void build_builtin(BuiltVariant& variant, cases::Variant kind, const Problem& pr
   if (row.on_fem_mesh) variant.tetrahedra = mesh.tetrahedra;
   if (problem.local_refinement)
     variant.refinement_added_nodes = row.surface_copies * problem.local_refinement->added_vertices;
-  variant.warnings = network.warnings;
+  for (const std::string& w : network.warnings)
+    variant.warnings.push_back({Warning::Kind::network, w});
   variant.model = std::make_unique<ms::MassSpringModel>(std::move(network));
   ms::MassSpringModel& model = *variant.model;
   const auto& rest = model.network().rest_positions;

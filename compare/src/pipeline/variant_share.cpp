@@ -9,12 +9,6 @@ namespace msfem::compare::detail {
 namespace {
 
 // One function per structure for both directions, so that a field cannot be written and not read.
-template <typename Io, typename M>
-void fields(Io& io, M& m) {  // ErrorMetrics
-  io.io(m.rel_l2_error), io.io(m.rms_error_m), io.io(m.max_error_m);
-  io.io(m.mean_error_over_max_disp), io.io(m.vertices);
-}
-
 template <typename Io, typename Curve>
 void curve_fields(Io& io, Curve& curve) {
   long long n = static_cast<long long>(curve.size());
@@ -27,13 +21,29 @@ void curve_fields(Io& io, Curve& curve) {
 
 template <typename Io, typename L>
 void load_fields(Io& io, L& o) {  // ToolLoadVariant (kind and name come from the variant)
-  fields(io, o.errors.all), fields(io, o.errors.contact_zone), fields(io, o.errors.far_field);
-  io.io(o.tool_force), io.io(o.reaction_force_rel_error), io.io(o.volume_change);
+  load_error_fields(io, o);
+  io.io(o.volume_change);
   io.io(o.inverted_elements);
   curve_fields(io, o.force_depth);
   io.io(o.force_depth_monotone), io.io(o.lost_tool), io.io(o.patch_mean_displacement);
   io.io(o.patch_displacement_rel_error), io.io(o.newton_iterations);
   io.io(o.equilibrium), io.io(o.surface_displacement), io.io(o.error);
+}
+
+template <typename Io, typename W>
+void warning_fields(Io& io, W& w) {  // Warning
+  int kind = static_cast<int>(w.kind);
+  long long load = w.load ? static_cast<long long>(*w.load) : -1;
+  long long n = static_cast<long long>(w.metrics.size());
+  io.io(kind), io.io(w.text), io.io(load), io.io(n);
+  w.kind = static_cast<Warning::Kind>(kind);
+  w.load = load < 0 ? std::nullopt : std::optional<std::size_t>(static_cast<std::size_t>(load));
+  w.metrics.resize(static_cast<std::size_t>(n));
+  for (Metric& m : w.metrics) {
+    int code = static_cast<int>(m);
+    io.io(code);
+    m = static_cast<Metric>(code);
+  }
 }
 
 template <typename Io, typename T>
@@ -84,7 +94,7 @@ void share_fields(Io& io, S& s) {
   io.io(n);
   r.warnings.resize(static_cast<std::size_t>(n));
   for (auto& w : r.warnings)
-    io.io(w);
+    warning_fields(io, w);
   n = static_cast<long long>(s.load_indices.size());
   io.io(n);
   s.load_indices.resize(static_cast<std::size_t>(n));

@@ -6,9 +6,9 @@
 
 #include "msfem/cases/network_file.hpp"
 #include "msfem/cases/setting_names.hpp"
-#include "msfem/compare/writers/calibration_outputs.hpp"
 #include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/json_values.hpp"
+#include "msfem/compare/writers/calibration_outputs.hpp"
 #include "msfem/compare/writers/plots.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 #include "msfem/compare/writers/text_format.hpp"
@@ -16,12 +16,12 @@
 namespace msfem::compare {
 namespace {
 
-nlohmann::json errors_json(const std::vector<LoadErrors>& errors) {
+nlohmann::json errors_json(const std::vector<CalibrationErrors>& errors) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& e : errors)
     list.push_back({{"load", e.load},
-                    {"rel_l2_error", e.rel_l2_error},
-                    {"mean_error_over_max_disp", e.mean_error_over_max_disp},
+                    {"rel_l2_error", e.displacement.all.rel_l2_error},
+                    {"mean_error_over_max_disp", e.displacement.all.mean_error_over_max_disp},
                     {"reaction_force_rel_error", e.reaction_force_rel_error},
                     {"reaction_force_N", {e.tool_force.x(), e.tool_force.y(), e.tool_force.z()}},
                     {"tool_patch_nodes", e.tool_patch_nodes}});
@@ -47,10 +47,11 @@ nlohmann::json side_json(const ErrorsOnLoads& e, double objective) {
   return {{"train", errors_json(e.train)}, {"test", errors_json(e.test)}, {"objective", objective}};
 }
 
-double mean_of(const std::vector<LoadErrors>& errors, double LoadErrors::*field) {
+template <typename Field>
+double mean_of(const std::vector<CalibrationErrors>& errors, Field field) {
   double sum = 0;
   for (const auto& e : errors)
-    sum += e.*field;
+    sum += field(e);
   return errors.empty() ? 0.0 : sum / static_cast<double>(errors.size());
 }
 
@@ -58,13 +59,14 @@ std::string loads_table(const CaseCalibration& c) {
   std::ostringstream t;
   t << "| set | load (direction@depth m) | rel L2 before | rel L2 after | mean err/max disp before "
        "| after | force err before | force err after |\n|---|---|---|---|---|---|---|---|\n";
-  auto rows = [&](const char* set, const std::vector<LoadErrors>& before,
-                  const std::vector<LoadErrors>& after) {
+  auto rows = [&](const char* set, const std::vector<CalibrationErrors>& before,
+                  const std::vector<CalibrationErrors>& after) {
     for (std::size_t i = 0; i < before.size(); ++i)
-      t << "| " << set << " | " << before[i].load << " | " << fmt("%.4f", before[i].rel_l2_error)
-        << " | " << fmt("%.4f", after[i].rel_l2_error) << " | "
-        << fmt("%.4f", before[i].mean_error_over_max_disp) << " | "
-        << fmt("%.4f", after[i].mean_error_over_max_disp) << " | "
+      t << "| " << set << " | " << before[i].load << " | "
+        << fmt("%.4f", before[i].displacement.all.rel_l2_error) << " | "
+        << fmt("%.4f", after[i].displacement.all.rel_l2_error) << " | "
+        << fmt("%.4f", before[i].displacement.all.mean_error_over_max_disp) << " | "
+        << fmt("%.4f", after[i].displacement.all.mean_error_over_max_disp) << " | "
         << fmt("%.4f", before[i].reaction_force_rel_error) << " | "
         << fmt("%.4f", after[i].reaction_force_rel_error) << " |\n";
   };
@@ -115,11 +117,12 @@ std::string report_markdown(const CaseCalibration& c, const std::string& plot) {
   for (const auto& n : c.notes)
     md << "> note: " << n << "\n\n";
   md << "## Errors per load, before and after\n\n" << loads_table(c) << "\n";
-  md << "Held-out means: rel L2 "
-     << fmt("%.4f", mean_of(fit.before.test, &LoadErrors::rel_l2_error)) << " → "
-     << fmt("%.4f", mean_of(fit.after.test, &LoadErrors::rel_l2_error)) << ", force error "
-     << fmt("%.4f", mean_of(fit.before.test, &LoadErrors::reaction_force_rel_error)) << " → "
-     << fmt("%.4f", mean_of(fit.after.test, &LoadErrors::reaction_force_rel_error)) << ".\n\n";
+  const auto l2 = [](const LoadErrors& e) { return e.displacement.all.rel_l2_error; };
+  const auto force = [](const LoadErrors& e) { return e.reaction_force_rel_error; };
+  md << "Held-out means: rel L2 " << fmt("%.4f", mean_of(fit.before.test, l2)) << " → "
+     << fmt("%.4f", mean_of(fit.after.test, l2)) << ", force error "
+     << fmt("%.4f", mean_of(fit.before.test, force)) << " → "
+     << fmt("%.4f", mean_of(fit.after.test, force)) << ".\n\n";
   md << "## Fitted coefficients\n\n" << coefficients_table(c) << "\n";
   md << "## Damping and mass\n\n"
      << "- tool-response mode of the calibrated model (its static deflection under the first "

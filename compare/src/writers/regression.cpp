@@ -7,9 +7,9 @@
 #include <iterator>
 #include <sstream>
 
+#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/pipeline/content_hash.hpp"
 #include "msfem/compare/pipeline/fem_cache.hpp"
-#include "msfem/compare/pipeline/atomic_file.hpp"
 #include "msfem/compare/writers/fields_h5.hpp"
 #include "msfem/compare/writers/run_summary.hpp"
 
@@ -25,9 +25,9 @@ constexpr double field_abs_tol_m = 1e-9, field_rel_tol = 1e-3;  // rel: of the l
 double metric_value(const ToolLoadVariant& v, Metric metric) {
   switch (metric) {
     case Metric::rel_l2_error:
-      return v.errors.all.rel_l2_error;
+      return v.displacement.all.rel_l2_error;
     case Metric::max_error_m:
-      return v.errors.all.max_error_m;
+      return v.displacement.all.max_error_m;
     case Metric::reaction_force_rel_error:
       return v.force_measured ? v.reaction_force_rel_error : std::nan("");
     case Metric::patch_displacement_rel_error:

@@ -179,12 +179,12 @@ std::string tool_positions_table(const CaseRun& run) {
     md << "| " << v.name << " |";
     for (const ToolLoadVariant& o : v.loads) {
       if (o.force_measured)
-        std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.errors.all.rel_l2_error,
+        std::snprintf(cell, sizeof cell, " %.3f / %.3f%s |", o.displacement.all.rel_l2_error,
                       o.reaction_force_rel_error, o.force_depth_monotone == false ? " †" : "");
       else
-        std::snprintf(cell, sizeof cell, " %.3f / - |", o.errors.all.rel_l2_error);
+        std::snprintf(cell, sizeof cell, " %.3f / - |", o.displacement.all.rel_l2_error);
       md << cell;
-      l2 += o.errors.all.rel_l2_error;
+      l2 += o.displacement.all.rel_l2_error;
       force += o.reaction_force_rel_error;
     }
     if (std::all_of(v.loads.begin(), v.loads.end(), [](const auto& o) { return o.force_measured; }))
@@ -285,14 +285,15 @@ std::string report_markdown(const CaseRun& run, const Plots& plots) {
                     v.timing.settled ? "" : " (not settled)");
     const ToolLoadVariant& own = v.loads.front();
     std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %s |\n", v.name.c_str(),
-                  own.errors.contact_zone.rel_l2_error, own.errors.far_field.rel_l2_error,
-                  own.errors.all.mean_error_over_max_disp, own.volume_change, settle);
+                  own.displacement.contact_zone.rel_l2_error,
+                  own.displacement.far_field.rel_l2_error,
+                  own.displacement.all.mean_error_over_max_disp, own.volume_change, settle);
     md << row;
   }
   md << tool_positions_table(run);
   for (const auto& v : run.variants)
-    for (const auto& w : v.warnings)
-      md << "\n> " << v.name << ": " << w << "\n";
+    for (const Warning& w : v.warnings)
+      md << "\n> " << v.name << ": " << w.written() << "\n";
   for (const auto& [name, why] : run.failed_variants)
     md << "\n> **" << name << " failed** and is left out of the tables and plots: " << why << "\n";
   md << "\n## Plots\n\n";

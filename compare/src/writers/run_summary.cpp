@@ -82,7 +82,7 @@ nlohmann::json refinement_json(const Problem& problem) {
 }
 
 nlohmann::json load_json(const CaseRun& run, std::size_t load, const ToolLoadVariant& o) {
-  const ZonedErrorMetrics& e = o.errors;
+  const ZonedErrorMetrics& e = o.displacement;
   return {{"tool", load},
           {"not_resolved_by_reference", metric_names(unresolved_metrics(run, o, load))},
           {"rel_l2_error", e.all.rel_l2_error},
@@ -112,7 +112,7 @@ nlohmann::json variant_loads(const CaseRun& run, const VariantResult& v) {
   const std::vector<ToolLoadVariant>& loads = v.loads;
   for (std::size_t t = 0; t < loads.size(); ++t) {
     list.push_back(load_json(run, t, loads[t]));
-    l2 += loads[t].errors.all.rel_l2_error;
+    l2 += loads[t].displacement.all.rel_l2_error;
     force += loads[t].reaction_force_rel_error;
     every_force = every_force && loads[t].force_measured;
   }
@@ -246,12 +246,12 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"nodes", v.nodes},
       {"springs", v.springs},
       {"contact_refinement_added_nodes", json_or_null(v.refinement_added_nodes)},
-      {"rel_l2_error", first.errors.all.rel_l2_error},
-      {"rms_error_m", first.errors.all.rms_error_m},
-      {"max_error_m", first.errors.all.max_error_m},
-      {"mean_error_over_max_disp", first.errors.all.mean_error_over_max_disp},
-      {"contact_zone", zone(first.errors.contact_zone)},
-      {"far_field", zone(first.errors.far_field)},
+      {"rel_l2_error", first.displacement.all.rel_l2_error},
+      {"rms_error_m", first.displacement.all.rms_error_m},
+      {"max_error_m", first.displacement.all.max_error_m},
+      {"mean_error_over_max_disp", first.displacement.all.mean_error_over_max_disp},
+      {"contact_zone", zone(first.displacement.contact_zone)},
+      {"far_field", zone(first.displacement.far_field)},
       {"reaction_force_N", tool ? vec(first.tool_force) : nlohmann::json()},
       {"reaction_force_rel_error",
        tool ? nlohmann::json(first.reaction_force_rel_error) : nlohmann::json()},
@@ -276,7 +276,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"force_depth_exponent",
        json_or_null(force_depth_exponent(first.force_depth, run.loads.front().tool))},
       {"inverted_elements", json_or_null(first.inverted_elements)},
-      {"warnings", v.warnings},
+      {"warnings", written(v.warnings)},
       {"parameters", parameters_json(v.parameters)}};
   if (run.loads.size() > 1) j["loads"] = variant_loads(run, v);
   return j;
@@ -433,8 +433,9 @@ std::string variant_table(const CaseRun& run) {
     std::snprintf(
         line, sizeof line, "| %-12s | %6d | %7s | %9s | %9.4f | %9s | %9s | %10s | %9s | %9s |\n",
         v.name.c_str(), v.nodes, springs,
-        error_cell(own.errors.all.rel_l2_error, contains(unresolved, Metric::rel_l2_error)).c_str(),
-        1e3 * own.errors.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
+        error_cell(own.displacement.all.rel_l2_error, contains(unresolved, Metric::rel_l2_error))
+            .c_str(),
+        1e3 * own.displacement.all.max_error_m, force, force_error.c_str(), steps, dt, frame);
     out << line;
   }
   out << table_notes(run);

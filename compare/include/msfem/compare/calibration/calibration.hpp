@@ -16,29 +16,24 @@
 
 #include "msfem/cases/case_parameters.hpp"
 #include "msfem/compare/pipeline/fem_error_estimate.hpp"
+#include "msfem/compare/pipeline/fem_references.hpp"
+#include "msfem/compare/pipeline/metrics.hpp"
 #include "msfem/compare/pipeline/problem.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
 #include "msfem/massspring/modal_damping.hpp"
 
 namespace msfem::compare {
 
-/// What the model is compared with on one load: the reference surface displacement and tool force.
-struct CalibrationLoad {
+/// What the model is compared with on one training or held-out load: the reference there, as
+/// msfem run's (its `tool` always set), and the load as the case or command line names it.
+struct CalibrationLoad : LoadReference {
   cases::ToolLoad load;
-  ToolPlacement tool;
-  Eigen::MatrixX3d surface_displacement;  ///< n_surface x 3, m
-  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
-  std::vector<int> compared_vertices;  ///< surface vertices no support or tool prescribes
-  LoadErrorEstimate fem_error;         ///< the reference's own error at this load (if estimated)
+  const ToolPlacement& placement() const { return *tool; }
 };
 
-/// The three errors of one load (DESIGN's definitions).
-struct LoadErrors {
+/// The errors of one load, as msfem run measures them, with the load's name and tool patch.
+struct CalibrationErrors : LoadErrors {
   std::string load;  ///< ToolLoad::label()
-  double rel_l2_error = 0.0;
-  double mean_error_over_max_disp = 0.0;
-  double reaction_force_rel_error = 0.0;
-  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
   /// Surface nodes the tool holds (bonded) or pushes (contact) in the spring model at this load.
   /// One node's force grows about
   /// linearly with depth while the FEM's resolved contact grows faster: no stiffness fits every
@@ -47,7 +42,7 @@ struct LoadErrors {
 };
 
 struct ErrorsOnLoads {
-  std::vector<LoadErrors> train, test;
+  std::vector<CalibrationErrors> train, test;
 };
 
 struct FittedGroup {
@@ -116,14 +111,14 @@ CalibrationFit calibrate(const Problem& problem, const BuiltVariant& base,
                          const CalibrationOptions& options);
 
 /// Errors of a built variant on one reference (its tool set to the reference's), with the static
-/// solve warm-started from `x` when it has the right size, or under a frictionless tool pressed
-/// from rest along quarters of its depth (finer with `path_step`, m), as msfem run presses; `x` is
-/// updated to the equilibrium.
-LoadErrors evaluate_load(BuiltVariant& variant, const CalibrationLoad& reference,
-                         Eigen::VectorXd& x, double path_step);
+/// solve warm-started from `x` when it has the right size, else pressed from rest along the case's
+/// loading path (loading_path) as msfem run presses; `x` is updated to the equilibrium.
+CalibrationErrors evaluate_load(const Problem& problem, BuiltVariant& variant,
+                                const CalibrationLoad& reference, Eigen::VectorXd& x);
 
 /// The same on the model linearised at rest (one Cholesky factorisation); throws
 /// std::runtime_error where that stiffness is singular.
-LoadErrors evaluate_load_linear(BuiltVariant& variant, const CalibrationLoad& reference);
+CalibrationErrors evaluate_load_linear(const Problem& problem, BuiltVariant& variant,
+                                       const CalibrationLoad& reference);
 
 }  // namespace msfem::compare

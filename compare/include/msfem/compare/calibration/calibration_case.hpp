@@ -53,7 +53,7 @@ struct CaseCalibration {
   std::vector<CalibrationLoad> train, test;
   CalibrationFit fit;
   massspring::DampingFit damping;
-  LoadErrors
+  CalibrationErrors
       nonlinear_check;  ///< the calibrated case re-solved (Newton) on the first training load
   double lumped_mass_kg = 0.0, fem_mass_kg = 0.0;
   std::vector<VariantOnTest> variants;  ///< sorted, best (lowest held-out rel_l2_error) first

@@ -25,13 +25,8 @@ namespace msfem::compare {
 
 /// One variant pressed at one load of the run (a tool position of the case, at the case's depth,
 /// reached along the loading path; or the case's gravity or patch force).
-struct ToolLoadVariant {
+struct ToolLoadVariant : LoadErrors {
   std::string name;  ///< the variant's
-  ZonedErrorMetrics errors;
-  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
-  double reaction_force_rel_error = 0.0;
-  /// False for an outside simulator's answer that carries no force: the force columns are empty.
-  bool force_measured = true;
   double volume_change = 0.0;
   std::optional<int> inverted_elements;
   std::vector<ForceDepthPoint> force_depth;  ///< every step of its loading path
@@ -77,7 +72,7 @@ struct VariantResult {
   std::optional<int> refinement_added_nodes;  ///< BuiltVariant's
   Timing timing;                              ///< from its equilibrium at the first load
   VariantParameters parameters;
-  std::vector<std::string> warnings;
+  std::vector<Warning> warnings;
   std::vector<ToolLoadVariant> loads;  ///< one per CaseRun::loads, in that order
   /// An outside simulator's answer (mass spring/results): no network, nothing timed here.
   bool external = false;
@@ -133,6 +128,13 @@ ToolLoadVariant measure_at_load(const Problem& problem, const std::string& name,
                                 const std::optional<Eigen::Vector3d>& tool_force,
                                 std::vector<ForceDepthPoint> curve, const LoadReference& load);
 
+/// A model's errors at `reference`'s load: its displacement at the case's surface vertices (rows
+/// beyond them, a finer surface's, are not compared) and its force on the tool (none: not
+/// measured). Throws std::invalid_argument for a displacement with fewer rows or not finite.
+LoadErrors load_errors(const Problem& problem, const LoadReference& reference,
+                       const Eigen::MatrixX3d& surface_displacement,
+                       const std::optional<Eigen::Vector3d>& tool_force);
+
 /// Force-depth depths of a tool: the case's list, or a quarter, half, three quarters and all of it.
 std::vector<double> curve_depths(const cases::ToolParameters& tool);
 
@@ -145,6 +147,12 @@ std::vector<double> loading_path(std::vector<double> depths, double case_depth, 
 /// further in one static step can pass through the surface or slide off it and leave the network
 /// untouched, an equilibrium with no force.
 double path_step_of(const cases::ToolParameters& tool);
+
+/// The one loading path of a spring variant (msfem run, sweep and calibrate): a load at `depth` is
+/// pressed from rest through the tool's curve depths scaled to it (a quarter, a half, three
+/// quarters and all of it when the case lists none), in steps no longer than path_step_of(tool).
+/// At the case's own depth the scale is 1: the path passes every curve depth.
+std::vector<double> loading_path(const cases::ToolParameters& tool, double depth);
 
 /// The metrics of `variant` at load `load` that lie within 3x the reference's own estimated error
 /// there: the reference does not resolve the variant's error in them.
@@ -177,9 +185,5 @@ BucklingOnset buckling_onset(std::vector<ForceDepthPoint> curve, const ToolPlace
 /// A variant's lateral reaction may exceed the FEM's own (the surface under the tool need not be
 /// flat) by this much of the axial force before the equilibrium counts as turned sideways.
 inline constexpr double lateral_fraction_margin = 0.25;
-/// Every buckling warning starts so (msfem run repeats them on stderr).
-inline constexpr const char* buckling_warning_start = "buckles under the tool";
-/// The warning of a variant that ends a load with no force where the FEM pushes back.
-inline constexpr const char* lost_tool_warning_start = "loses the tool";
 
 }  // namespace msfem::compare

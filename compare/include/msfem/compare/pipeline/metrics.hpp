@@ -47,6 +47,16 @@ ZonedErrorMetrics zoned_displacement_error(const Eigen::MatrixX3d& u, const Eige
                                            const std::vector<int>& rows,
                                            const Eigen::Vector3d& tool_point, double zone_radius);
 
+/// A model's errors at one load against the reference there (DESIGN's definitions): what msfem
+/// run, sweep and calibrate each measure, by load_errors (case_run.hpp).
+struct LoadErrors {
+  ZonedErrorMetrics displacement;  ///< over the compared surface vertices, and by zone
+  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
+  /// False for an outside simulator's answer that carries no force: the force columns are empty.
+  bool force_measured = true;
+  double reaction_force_rel_error = 0.0;  ///< with a tool and a measured force; 0 otherwise
+};
+
 /// |F_ms − F_fem| / |F_fem|; throws std::invalid_argument if the reference force is zero.
 double reaction_force_rel_error(const Eigen::Vector3d& model, const Eigen::Vector3d& reference);
 

@@ -10,6 +10,7 @@
 
 #include "msfem/compare/pipeline/problem.hpp"
 #include "msfem/compare/pipeline/variant_spec.hpp"
+#include "msfem/compare/pipeline/warning.hpp"
 #include "msfem/fem_reference/volume_mesh.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/modulus_field.hpp"
@@ -62,7 +63,7 @@ struct BuiltVariant {
   Eigen::MatrixX4i tetrahedra;
   /// The E its springs and volume elements were given (the case's E, or the image's range).
   massspring::ModulusRange youngs_modulus_range;
-  std::vector<std::string> warnings;
+  std::vector<Warning> warnings;
 };
 BuiltVariant build_variant(const VariantSpec& spec, const Problem& problem,
                            const fem_reference::VolumeMesh& mesh,
