@@ -12,6 +12,7 @@
 #include "kernels/gather_kernels.hpp"
 #include "kernels/soa_layout.hpp"
 #include "kernels/thread_team.hpp"
+#include "solvers/fast_lanes.hpp"
 
 namespace msfem::massspring {
 
@@ -277,15 +278,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 FastImplicitStepper::FastImplicitStepper(const MechanicalSystem& model,
                                          const FastImplicitOptions& options) {
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
-  if (options.single_precision &&
-      detail::preferred_lanes<float>(
-          true, spring_field(model, "the fast stepper").network().num_springs(),
-          model.num_nodes()) == 16)
-    impl_ = std::make_unique<GatherImplicitStepper<float, 16>>(model, options);
-  else if (options.single_precision)
-    impl_ = std::make_unique<GatherImplicitStepper<float, 8>>(model, options);
-  else
-    impl_ = std::make_unique<GatherImplicitStepper<double, 4>>(model, options);
+  impl_ = detail::kernel_for_lanes<GatherImplicitStepper, Implementation>(model, options, true);
 }
 FastImplicitStepper::~FastImplicitStepper() = default;
 

@@ -16,6 +16,7 @@
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/nodal_load_field.hpp"
 #include "msfem/massspring/stability.hpp"
+#include "solvers/fast_lanes.hpp"
 
 namespace msfem::massspring {
 
@@ -347,15 +348,8 @@ FastExplicitStepper::FastExplicitStepper(const MechanicalSystem& model,
       options.integrator != IntegratorKind::rk4)
     throw ModelError("fast explicit stepper: integrator '" + to_string(options.integrator) +
                      "' not supported (symplectic_euler, explicit_euler, rk4)");
-  if (options.single_precision &&
-      detail::preferred_lanes<float>(
-          options.allow_avx512, spring_field(model, "the fast stepper").network().num_springs(),
-          model.num_nodes()) == 16)
-    impl_ = std::make_unique<GatherExplicitStepper<float, 16>>(model, options);
-  else if (options.single_precision)
-    impl_ = std::make_unique<GatherExplicitStepper<float, 8>>(model, options);
-  else
-    impl_ = std::make_unique<GatherExplicitStepper<double, 4>>(model, options);
+  impl_ = detail::kernel_for_lanes<GatherExplicitStepper, Implementation>(model, options,
+                                                                          options.allow_avx512);
 }
 
 FastExplicitStepper::~FastExplicitStepper() = default;
