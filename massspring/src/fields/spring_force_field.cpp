@@ -30,6 +30,23 @@ void add_block(Triplets& triplets, int row_node, int col_node, const Eigen::Matr
       triplets.emplace_back(3 * row_node + r, 3 * col_node + c, block(r, c));
 }
 
+// A two-node element's derivative: ∂f_i/∂x_j = block, so ∂f_i/∂x_i = −block (the pair's force
+// depends on x_j − x_i alone), and the same for j.
+void add_pair_blocks(Triplets& triplets, int i, int j, const Eigen::Matrix3d& block) {
+  add_block(triplets, i, j, block);
+  add_block(triplets, j, i, block);
+  add_block(triplets, i, i, -block);
+  add_block(triplets, j, j, -block);
+}
+
+// Each anchor's (or node damper's) diagonal: −c on its node's three rows.
+void add_node_diagonals(Triplets& triplets, const Eigen::VectorXi& nodes,
+                        const Eigen::VectorXd& coefficients) {
+  for (Eigen::Index a = 0; a < nodes.size(); ++a)
+    for (int r = 0; r < 3; ++r)
+      triplets.emplace_back(3 * nodes[a] + r, 3 * nodes[a] + r, -coefficients[a]);
+}
+
 }  // namespace
 
 SpringForceField::SpringForceField(const SpringNetwork& network)
@@ -156,15 +173,9 @@ void SpringForceField::add_dfdx_triplets(const Eigen::VectorXd& x, const Eigen::
     const int i = net.springs(s, 0);
     const int j = net.springs(s, 1);
     const Eigen::Matrix3d block = spring_dfdx_block(s, x, v, mode);
-    add_block(triplets, i, j, block);
-    add_block(triplets, j, i, block);
-    add_block(triplets, i, i, -block);
-    add_block(triplets, j, j, -block);
+    add_pair_blocks(triplets, i, j, block);
   }
-  for (int a = 0; a < net.num_anchors(); ++a)
-    for (int r = 0; r < 3; ++r)
-      triplets.emplace_back(3 * net.anchor_node[a] + r, 3 * net.anchor_node[a] + r,
-                            -net.anchor_stiffness[a]);
+  add_node_diagonals(triplets, net.anchor_node, net.anchor_stiffness);
 }
 
 void SpringForceField::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& triplets) const {
@@ -176,15 +187,9 @@ void SpringForceField::add_dfdv_triplets(const Eigen::VectorXd& x, Triplets& tri
     const SpringFrame fr = frame(x, i, j);
     if (!fr.valid) continue;
     const Eigen::Matrix3d block = net.damping[s] * fr.n * fr.n.transpose();
-    add_block(triplets, i, j, block);
-    add_block(triplets, j, i, block);
-    add_block(triplets, i, i, -block);
-    add_block(triplets, j, j, -block);
+    add_pair_blocks(triplets, i, j, block);
   }
-  for (int a = 0; a < net.num_anchors(); ++a)
-    for (int r = 0; r < 3; ++r)
-      triplets.emplace_back(3 * net.anchor_node[a] + r, 3 * net.anchor_node[a] + r,
-                            -net.anchor_damping[a]);
+  add_node_diagonals(triplets, net.anchor_node, net.anchor_damping);
   for (int i = 0; i < net.num_nodes(); ++i)
     for (int r = 0; r < 3; ++r)
       triplets.emplace_back(3 * i + r, 3 * i + r, -net.node_damping[i]);
