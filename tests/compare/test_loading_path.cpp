@@ -71,6 +71,11 @@ TEST(LoadingPath, EveryLoadFollowsTheCasesCurveScaledToItsDepth) {
   EXPECT_DOUBLE_EQ(half[0], 0.001);
   EXPECT_EQ(half[1], 0.002);  // the load's own depth exactly, where its equilibrium is read
   EXPECT_DOUBLE_EQ(half[2], 0.003);
+  // The case's depth lands on the load's exactly (0.004 · 0.0045/0.004 is not 0.0045 in doubles).
+  tool.curve_depths_m = {0.002, 0.004};
+  const std::vector<double> deeper = loading_path(tool, 0.0045);
+  ASSERT_EQ(deeper.size(), 2u);
+  EXPECT_EQ(deeper[1], 0.0045);
   // A frictionless tool of radius 2 mm: no step over half a millimetre.
   tool.mode = cases::ToolParameters::Mode::contact;
   tool.radius_m = 0.002;
@@ -79,7 +84,7 @@ TEST(LoadingPath, EveryLoadFollowsTheCasesCurveScaledToItsDepth) {
     EXPECT_LE(d - last, 0.0005 + 1e-15);
     last = d;
   }
-  EXPECT_EQ(last, 0.003);
+  EXPECT_EQ(last, 0.002);
 }
 
 BuiltVariant one_tetrahedron() {

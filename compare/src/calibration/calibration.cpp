@@ -118,7 +118,11 @@ LoadModels models_for(const BuiltVariant& base, const std::vector<CalibrationLoa
 // follows.
 StaticSolution equilibrium_from_rest(BuiltVariant& variant, const CalibrationLoad& reference,
                                      const cases::ToolParameters& tool) {
-  return press(variant, reference.tool, loading_path(tool, reference.placement().depth));
+  // Past the load's depth the path only records run's force-depth curve: calibrate stops there.
+  const double depth = reference.placement().depth;
+  std::vector<double> path = loading_path(tool, depth);
+  path.erase(std::find(path.begin(), path.end(), depth) + 1, path.end());
+  return press(variant, reference.tool, path);
 }
 
 // The load's equilibrium from `x`, or from rest as msfem run reaches it when `x` is empty.

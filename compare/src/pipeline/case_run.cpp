@@ -314,6 +314,11 @@ ToolLoadVariant measure_at_load(const Problem& problem, const std::string& name,
                                 std::vector<ForceDepthPoint> curve, const LoadReference& load) {
   const FemSolution& fem = load.fem;
   const std::optional<ToolPlacement>& tool = load.tool;
+  // The answer's surface is the case's (a variant's finer surface is cut to it when solved).
+  if (surface_displacement.rows() != fem.surface_displacement.rows())
+    throw std::invalid_argument(
+        "displacement fields differ in size: " + std::to_string(surface_displacement.rows()) +
+        " vs " + std::to_string(fem.surface_displacement.rows()) + " vertices");
   ToolLoadVariant o;
   static_cast<LoadErrors&>(o) = load_errors(problem, load, surface_displacement, tool_force);
   o.name = name;
@@ -386,9 +391,10 @@ std::vector<double> loading_path(const cases::ToolParameters& tool, double depth
   std::vector<double> depths = {0.25 * depth, 0.5 * depth, 0.75 * depth, depth};
   if (!tool.curve_depths_m.empty()) {
     depths = tool.curve_depths_m;
-    if (depth != tool.depth_m)
-      for (double& d : depths)
-        d *= depth / tool.depth_m;
+    // The case's own depth maps onto the load's exactly, so that the load's equilibrium is one
+    // point of the path, not two an ulp apart.
+    for (double& d : depths)
+      d = d == tool.depth_m ? depth : d * (depth / tool.depth_m);
   }
   return loading_path(std::move(depths), depth, path_step_of(tool));
 }
