@@ -159,6 +159,51 @@ TEST(VolumeForceField, TetrahedronElementsJacobiansMatchFiniteDifferences) {
   EXPECT_LE(errors.energy_gradient, 1e-6);
 }
 
+// Elements of two shapes, neither filling its last lane group (the force pass groups elements of
+// one shape eight to a vector): prisms of the shell and single tetrahedra in the first of them.
+TEST(VolumeForceField, MixedShapesInPartialLaneGroupsMatchFiniteDifferences) {
+  const SpringNetwork network = three_tier_sphere(1);
+  const int nv = static_cast<int>(network.surface_nodes.size());
+  VolumeElements mixed =
+      tier_prisms(network.rest_positions, network.surface_triangles, nv, 2, 8000.0);
+  const int prisms = 77;  // of 80: 9 groups, the last with 5 lanes
+  const int prism_tets = mixed.tet_start[prisms];
+  mixed.tet_start.resize(prisms + 1);
+  Eigen::MatrixX4i tets(prism_tets + 11, 4);
+  Eigen::VectorXd weights(tets.rows());
+  tets.topRows(prism_tets) = mixed.tets.topRows(prism_tets);
+  weights.head(prism_tets) = mixed.tet_weight.head(prism_tets);
+  for (int k = 0; k < 11; ++k) {  // the first tetrahedron of each of 11 prisms, weight 1
+    tets.row(prism_tets + k) = mixed.tets.row(mixed.tet_start[k]);
+    weights[prism_tets + k] = 1.0;
+    mixed.tet_start.push_back(prism_tets + k + 1);
+  }
+  mixed.tets = tets;
+  mixed.tet_weight = weights;
+  const Eigen::VectorXd x0 = flatten(network.rest_positions);
+  mixed.rest_volume.conservativeResize(prisms + 11);
+  mixed.modulus = Eigen::VectorXd::LinSpaced(prisms + 11, 2000.0, 9000.0);
+  for (int k = 0; k < 11; ++k) {
+    const Eigen::Vector3d a = network.rest_positions.row(tets(prism_tets + k, 0)),
+                          b = network.rest_positions.row(tets(prism_tets + k, 1)),
+                          c = network.rest_positions.row(tets(prism_tets + k, 2)),
+                          d = network.rest_positions.row(tets(prism_tets + k, 3));
+    mixed.rest_volume[prisms + k] = (b - a).dot((c - a).cross(d - a)) / 6.0;
+  }
+  const VolumeForceField volume(network.num_nodes(), mixed);
+  const Eigen::VectorXd x = perturbed(x0, 0.004, 17);
+  const auto errors = check_force_jacobians(volume, x, Eigen::VectorXd::Zero(x.size()), 1e-7);
+  EXPECT_LE(errors.dfdx_matrix, 1e-6);
+  EXPECT_LE(errors.dfdx_product, 1e-6);
+  EXPECT_LE(errors.energy_gradient, 1e-6);
+  // Three parts sum to the whole force.
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size()), parts = f;
+  volume.add_force(x, Eigen::VectorXd::Zero(x.size()), f);
+  for (int part = 0; part < 3; ++part)
+    volume.add_force_part(x, Eigen::VectorXd::Zero(x.size()), parts, part, 3);
+  EXPECT_LE((parts - f).norm(), 1e-13 * f.norm());
+}
+
 TEST(VolumeForceField, PrismsFillTheShellsBetweenTheTiers) {
   // The icosphere's tiers are scaled copies, so the prisms between tiers s1 and s2 fill exactly
   // the enclosed polyhedra's volume difference, (1/s1³ − 1/s2³) V_outer.

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "fields/volume_batches.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/spring_network.hpp"
 
@@ -173,6 +174,9 @@ void VolumeForceField::index_element_nodes() {
       }
     element_node_start_.push_back(static_cast<int>(element_node_offset_.size()));
   }
+  batches_ = std::make_shared<const detail::VolumeBatches>(
+      detail::batch_elements(element_node_start_, element_node_offset_, local_tets_,
+                             elements_.tet_start, elements_.tet_weight.data()));
 }
 
 std::shared_ptr<const ForceField> VolumeForceField::scaled(const std::string& group,
@@ -259,20 +263,23 @@ std::pair<int, int> VolumeForceField::element_range(int part, int parts) const {
           static_cast<int>(elements * (part + 1) / parts)};
 }
 
+// Per lane group: the volumes and gradients of its elements, the pressures
+// κ (V − V⁰)/|V⁰|, and f += pressure g / 6 at their nodes.
 void VolumeForceField::add_force_part(const Eigen::VectorXd& x, const Eigen::VectorXd&,
                                       Eigen::VectorXd& f, int part, int parts) const {
-  double* pf = f.data();
-  Vec3 g[kMaxElementNodes];  // −6 ∂V/∂x per node of the element
-  const auto [first, last] = element_range(part, parts);
-  for (int e = first; e < last; ++e) {
-    const double v0 = elements_.rest_volume[e];
-    const double pressure =
-        elements_.modulus[e] * (element_gradient(e, x.data(), g) - v0) / std::abs(v0);
-    if (pressure == 0.0) continue;
-    const int* offset = element_node_offset_.data() + element_node_start_[e];
-    const int nodes = element_node_start_[e + 1] - element_node_start_[e];
-    for (int k = 0; k < nodes; ++k)
-      Vec3::Map(pf + offset[k]) += (pressure / 6.0) * g[k];
+  const detail::VolumeBatches& b = *batches_;
+  constexpr int L = detail::kVolumeLanes;
+  alignas(64) double g[3 * detail::kMaxShapeNodes * L];
+  double volume[L], s[L];
+  const auto [first, last] = b.group_range(part, parts);
+  for (int group = first; group < last; ++group) {
+    detail::group_gradient(b, group, x.data(), g, volume);
+    for (int l = 0; l < L; ++l) {
+      const int e = b.element[static_cast<std::size_t>(group * L + l)];
+      const double v0 = elements_.rest_volume[e];
+      s[l] = elements_.modulus[e] * (volume[l] - v0) / std::abs(v0) / 6.0;
+    }
+    detail::scatter_group(b, group, g, s, f.data());
   }
 }
 
@@ -321,65 +328,85 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
         scale_(static_cast<std::size_t>(field.elements_.num_elements()), 0.0),
         volume_(scale_.size(), 0.0) {}
 
+  // The gradients in the field's lane groups (volume_batches.hpp), kept per element: a product
+  // then reads an element's gradient as one contiguous run beside its node offsets.
   void set_part(int part, int parts) override {
     const auto& f = *field_;
-    const auto [first, last] = f.element_range(part, parts);
-    for (int e = first; e < last; ++e) {
-      scale_[static_cast<std::size_t>(e)] =
-          f.elements_.modulus[e] / std::abs(f.elements_.rest_volume[e]);
-      Vec3 g[VolumeForceField::kMaxElementNodes];
-      volume_[static_cast<std::size_t>(e)] = f.element_gradient(e, x_->data(), g);
-      std::copy(g, g + nodes(e), g_.begin() + f.element_node_start_[e]);
+    const detail::VolumeBatches& b = *f.batches_;
+    constexpr int L = detail::kVolumeLanes;
+    alignas(64) double g[3 * detail::kMaxShapeNodes * L];
+    double volume[L];
+    const auto [first, last] = b.group_range(part, parts);
+    for (int group = first; group < last; ++group) {
+      detail::group_gradient(b, group, x_->data(), g, volume);
+      for (int l = 0; l < b.group_lanes[group]; ++l) {
+        const int e = b.element[static_cast<std::size_t>(group * L + l)];
+        scale_[static_cast<std::size_t>(e)] =
+            f.elements_.modulus[e] / std::abs(f.elements_.rest_volume[e]);
+        volume_[static_cast<std::size_t>(e)] = volume[l];
+        Vec3* kept = g_.data() + f.element_node_start_[e];
+        for (int k = 0; k < nodes(e); ++k)
+          kept[k] = Vec3(g[3 * k * L + l], g[(3 * k + 1) * L + l], g[(3 * k + 2) * L + l]);
+      }
     }
   }
 
   void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
                         int parts) const override {
-    const auto [first, last] = field_->element_range(part, parts);
-    for (int e = first; e < last; ++e)
+    for_each_element(part, parts, [&](int e) {
       if (scale_[static_cast<std::size_t>(e)] != 0.0)
         add_element_product(gradient(e), offsets(e), nodes(e), scale_[static_cast<std::size_t>(e)],
                             dx.data(), df.data());
+    });
   }
 
   void add_product_pair_part(const Eigen::VectorXd& dx1, Eigen::VectorXd& df1,
                              const Eigen::VectorXd& dx2, Eigen::VectorXd& df2, int part,
                              int parts) const override {
-    const auto [first, last] = field_->element_range(part, parts);
-    for (int e = first; e < last; ++e)
+    for_each_element(part, parts, [&](int e) {
       if (scale_[static_cast<std::size_t>(e)] != 0.0)
         add_element_product_pair(gradient(e), offsets(e), nodes(e),
                                  scale_[static_cast<std::size_t>(e)], dx1.data(), df1.data(),
                                  dx2.data(), df2.data());
+    });
   }
 
   // The force −κ (V − V⁰)/|V⁰| ∂V = scale (V − V⁰) g / 6 from the gradient and volume set_part
   // kept: the explicit pass's work without its second read of x.
   bool add_force_part(Eigen::VectorXd& f, int part, int parts) const override {
-    const auto [first, last] = field_->element_range(part, parts);
-    for (int e = first; e < last; ++e) {
+    for_each_element(part, parts, [&](int e) {
       const double pressure =
           scale_[static_cast<std::size_t>(e)] *
           (volume_[static_cast<std::size_t>(e)] - field_->elements_.rest_volume[e]);
-      if (pressure == 0.0) continue;
+      if (pressure == 0.0) return;
       const Vec3* g = gradient(e);
       const int* offset = offsets(e);
       for (int k = 0; k < nodes(e); ++k)
         Vec3::Map(f.data() + offset[k]) += (pressure / 6.0) * g[k];
-    }
+    });
     return true;
   }
 
   // The field has no velocity term: cv does not enter.
   void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
                                 int parts) const override {
-    const auto [first, last] = field_->element_range(part, parts);
-    for (int e = first; e < last; ++e)
+    for_each_element(part, parts, [&](int e) {
       add_element_blocks(gradient(e), offsets(e), nodes(e), cx, scale_[static_cast<std::size_t>(e)],
                          blocks);
+    });
   }
 
  private:
+  // The elements of part `part` of `parts` of the lane groups: set_part's, so that a thread reads
+  // only the gradients it wrote itself.
+  template <class Visit>
+  void for_each_element(int part, int parts, const Visit& visit) const {
+    const detail::VolumeBatches& b = *field_->batches_;
+    const auto [first, last] = b.group_range(part, parts);
+    for (int group = first; group < last; ++group)
+      for (int l = 0; l < b.group_lanes[group]; ++l)
+        visit(b.element[static_cast<std::size_t>(group * detail::kVolumeLanes + l)]);
+  }
   int nodes(int e) const {
     return field_->element_node_start_[e + 1] - field_->element_node_start_[e];
   }

@@ -3,12 +3,17 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "msfem/massspring/force_model.hpp"
 
 namespace msfem::massspring {
+
+namespace detail {
+struct VolumeBatches;
+}
 
 /// Volume elements of a network: element e has the volume V_e = Σ w_t V_t over the tetrahedra
 /// t = tet_start[e] .. tet_start[e + 1] - 1 (rows of `tets`, 4 node ids each, weights
@@ -40,15 +45,15 @@ class VolumeForceField : public ForceField {
   int num_dofs() const override { return 3 * num_nodes_; }
   void add_force(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                  Eigen::VectorXd& f) const override;
-  /// Elements [E·part/parts, E·(part+1)/parts) only: threads that each take a part into their own
-  /// f sum to add_force.
+  /// Part `part` of `parts` of the elements: threads that each take a part into their own f sum
+  /// to add_force.
   void add_force_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f,
                       int part, int parts) const override;
   double potential_energy(const Eigen::VectorXd& x) const override;
   void add_dfdx_product(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                         const Eigen::VectorXd& dx, Eigen::VectorXd& df,
                         Linearisation mode = Linearisation::exact) const override;
-  /// Elements [E·part/parts, E·(part+1)/parts) only.
+  /// Part `part` of `parts` of the elements.
   void add_dfdx_product_part(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                              const Eigen::VectorXd& dx, Eigen::VectorXd& df, Linearisation mode,
                              int part, int parts) const override;
@@ -99,6 +104,9 @@ class VolumeForceField : public ForceField {
   std::vector<int> element_node_start_{0};
   std::vector<int> element_node_offset_;
   std::vector<std::array<std::uint8_t, 4>> local_tets_;
+  // The elements in lane groups of one shape each (volume_batches.hpp), for the force, the
+  // definite product and the tangent; shared by copies (it holds no modulus).
+  std::shared_ptr<const detail::VolumeBatches> batches_;
 };
 
 /// The prisms between a triangle mesh's tiers: for every triangle (a, b, c) of `triangles` and
