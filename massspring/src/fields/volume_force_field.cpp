@@ -174,6 +174,7 @@ void VolumeForceField::index_element_nodes() {
       }
     element_node_start_.push_back(static_cast<int>(element_node_offset_.size()));
   }
+  static_assert(detail::kMaxShapeNodes == kMaxElementNodes, "a lane group holds any element");
   batches_ = std::make_shared<const detail::VolumeBatches>(
       detail::batch_elements(element_node_start_, element_node_offset_, local_tets_,
                              elements_.tet_start, elements_.tet_weight.data()));

@@ -104,8 +104,8 @@ class VolumeForceField : public ForceField {
   std::vector<int> element_node_start_{0};
   std::vector<int> element_node_offset_;
   std::vector<std::array<std::uint8_t, 4>> local_tets_;
-  // The elements in lane groups of one shape each (volume_batches.hpp), for the force, the
-  // definite product and the tangent; shared by copies (it holds no modulus).
+  // The elements in lane groups of one shape each (volume_batches.hpp), for the force pass and the
+  // kept tangent's gradients; shared by copies (it holds no modulus).
   std::shared_ptr<const detail::VolumeBatches> batches_;
 };
 
