@@ -100,6 +100,9 @@ void set_rigid_body_modes(MPI_Comm communicator, Mat matrix,
   MSFEM_PETSC(MatSetNearNullSpace(matrix, modes));
 }
 
+}  // namespace
+
+// Outside the anonymous namespace: PetscLinearSystem::KrylovState holds one.
 /// What two_level_preconditioner creates, destroyed after the solve.
 struct TwoLevel {
   Mat interpolation = nullptr, coarse = nullptr;
@@ -112,6 +115,8 @@ struct TwoLevel {
     MatDestroy(&interpolation);
   }
 };
+
+namespace {
 
 /// p-multigrid for P2: GAMG on the P2 matrix needs 240 CG iterations on the 1.2 M-DoF brain (its
 /// smoothed aggregates of P2 nodes see the badly shaped cells), GAMG on P1 about half as many. Two

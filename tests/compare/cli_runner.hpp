@@ -12,6 +12,9 @@
 
 namespace msfem::testing {
 
+/// The small sphere case the run, sweep and modulus-image tests share (tests/compare/data).
+inline const std::string small_sphere_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm";
+
 struct CommandResult {
   int exit_code = -1;
   std::string out, err;

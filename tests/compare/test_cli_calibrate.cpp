@@ -17,13 +17,13 @@ using testing::read_text;
 using testing::run_msfem;
 using testing::TemporaryDirectory;
 
-const std::string small_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_calibrate.prm";
+const std::string small_calibrate_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_calibrate.prm";
 
 TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
   TemporaryDirectory tmp;
   const auto out = tmp / "cal";
-  const auto r = run_msfem("calibrate " + small_case + " --quiet --json --out " + out.string() +
-                           " --set output/directory=" + (tmp / "runs").string());
+  const auto r = run_msfem("calibrate " + small_calibrate_case + " --quiet --json --out " +
+                           out.string() + " --set output/directory=" + (tmp / "runs").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["variant"], "three_tier");
@@ -88,7 +88,7 @@ TEST(CliCalibrate, CaseDefaultsGiveBeforeAndAfterAndACalibratedCaseThatRuns) {
 TEST(CliCalibrate, TheFittedVolumeModulusIsWhatCalibratedPrmBuilds) {
   TemporaryDirectory tmp;
   const auto out = tmp / "cal";
-  const auto r = run_msfem("calibrate " + small_case +
+  const auto r = run_msfem("calibrate " + small_calibrate_case +
                            " --quiet --json --fit tier1_edges,volume --set 'material/poisson "
                            "ratio=0.45' --set 'mass spring/volume preservation=true' --out " +
                            out.string() + " --set output/directory=" + (tmp / "runs").string());
@@ -121,15 +121,15 @@ TEST(CliCalibrate, ContactModeFitsAgainstTheFrictionlessReference) {
   TemporaryDirectory tmp;
   const std::string contact = " --set loads/tool/mode=contact" +
                               std::string(" --set \"mass spring/three tier/inner diagonals=true\"");
-  const auto r = run_msfem("calibrate " + small_case + " --quiet --json" + contact + " --out " +
-                           (tmp / "cal").string());
+  const auto r = run_msfem("calibrate " + small_calibrate_case + " --quiet --json" + contact +
+                           " --out " + (tmp / "cal").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_LT(j["after"]["objective"].get<double>(), 0.5 * j["before"]["objective"].get<double>());
   for (const auto& e : j["after"]["train"])
     EXPECT_GT(e["tool_patch_nodes"].get<int>(), 1) << e["load"];
   const auto linear =
-      run_msfem("calibrate " + small_case + " --quiet" + contact +
+      run_msfem("calibrate " + small_calibrate_case + " --quiet" + contact +
                 " --set calibration/model=linear --out " + (tmp / "linear").string());
   EXPECT_EQ(linear.exit_code, 2) << linear.err;
   EXPECT_NE(linear.err.find("calibration/model = linear"), std::string::npos) << linear.err;
@@ -176,8 +176,8 @@ TEST(CliCalibrate, BadInputIsOneLineAndLeavesNoResultFolder) {
   };
   for (const auto& [options, named] : cases) {
     const auto out = tmp / "out";
-    const auto r = run_msfem("calibrate " + small_case + " --quiet --no-cache " + options +
-                             " --out " + out.string());
+    const auto r = run_msfem("calibrate " + small_calibrate_case + " --quiet --no-cache " +
+                             options + " --out " + out.string());
     EXPECT_EQ(r.exit_code, 2) << options << ": " << r.err;
     EXPECT_EQ(count_lines(r.err), 1u) << r.err;
     EXPECT_NE(r.err.find(named), std::string::npos) << options << ": " << r.err;
@@ -187,16 +187,18 @@ TEST(CliCalibrate, BadInputIsOneLineAndLeavesNoResultFolder) {
 
 TEST(CliCalibrate, AnOptimiserThatDoesNotConvergeKeepsTheBestPointAndFailsUnderStrict) {
   TemporaryDirectory tmp;
-  const auto lenient = run_msfem("calibrate " + small_case + " --quiet --no-cache --json " +
-                                 "--no-compare --max-evaluations 3 --out " + (tmp / "a").string());
+  const auto lenient =
+      run_msfem("calibrate " + small_calibrate_case + " --quiet --no-cache --json " +
+                "--no-compare --max-evaluations 3 --out " + (tmp / "a").string());
   ASSERT_EQ(lenient.exit_code, 0) << lenient.err;
   EXPECT_NE(lenient.err.find("did not converge"), std::string::npos) << lenient.err;
   const auto j = nlohmann::json::parse(lenient.out);
   EXPECT_FALSE(j["optimiser"]["converged"].get<bool>());
   EXPECT_LE(j["after"]["objective"].get<double>(), j["before"]["objective"].get<double>());
 
-  const auto strict = run_msfem("calibrate " + small_case + " --quiet --no-cache --strict " +
-                                "--no-compare --max-evaluations 3 --out " + (tmp / "b").string());
+  const auto strict =
+      run_msfem("calibrate " + small_calibrate_case + " --quiet --no-cache --strict " +
+                "--no-compare --max-evaluations 3 --out " + (tmp / "b").string());
   EXPECT_EQ(strict.exit_code, 1) << strict.err;
   EXPECT_TRUE(std::filesystem::exists(tmp / "b" / "calibrated.prm"));  // the best point, kept
 }

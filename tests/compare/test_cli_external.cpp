@@ -23,9 +23,10 @@ using testing::read_text;
 using testing::run_msfem;
 using testing::TemporaryDirectory;
 
-const std::string sphere = std::string(MSFEM_CASES_DIR) +
-                           "/sphere_indent.prm --set geometry/source=icosphere:2:0.05 --set "
-                           "fem/degree=1 --set 'fem/error estimate=none'";
+const std::string coarse_sphere_args =
+    std::string(MSFEM_CASES_DIR) +
+    "/sphere_indent.prm --set geometry/source=icosphere:2:0.05 --set "
+    "fem/degree=1 --set 'fem/error estimate=none'";
 
 // The answer as a simulator writes it: the case's surface (surface.vtu's points) with point data
 // displacement, and the tool force in STEM.force.json beside it.
@@ -42,9 +43,11 @@ class ExternalResults : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TemporaryDirectory;
-    ASSERT_EQ(run_msfem("export-load " + sphere + " " + path("load").string()).exit_code, 0);
-    ASSERT_EQ(run_msfem("run " + sphere + " --quiet --no-timing --set 'mass spring/variants=" +
-                        "three_tier' --out " + path("run").string())
+    ASSERT_EQ(
+        run_msfem("export-load " + coarse_sphere_args + " " + path("load").string()).exit_code, 0);
+    ASSERT_EQ(run_msfem("run " + coarse_sphere_args +
+                        " --quiet --no-timing --set 'mass spring/variants=" + "three_tier' --out " +
+                        path("run").string())
                   .exit_code,
               0);
     const auto h5 = path("run") / "fields.h5";
@@ -99,7 +102,7 @@ TEST_F(ExternalResults, TheLoadsAreDescribedForAnOutsideSimulator) {
 }
 
 TEST_F(ExternalResults, TheFemsOwnAnswerHasNoErrorAndAVariantsOwnItsMetrics) {
-  const auto r = run_msfem("run " + sphere + " --quiet --no-timing" +
+  const auto r = run_msfem("run " + coarse_sphere_args + " --quiet --no-timing" +
                            results("fem=" + path("fem.vtu").string() +
                                    "; tiers=" + path("tiers.vtu").string() +
                                    "; bare=" + path("no_force.vtu").string()) +
@@ -130,7 +133,8 @@ TEST_F(ExternalResults, ASecondProgramsAnswerFromTheExportedLoadsIsMeasuredAsThe
   for (const char* mode : {"contact", "prescribed"}) {
     const std::string name = mode;
     const std::string setting = " --set loads/tool/mode=" + name;
-    ASSERT_EQ(run_msfem("export-load " + sphere + setting + " " + path("load_" + name).string())
+    ASSERT_EQ(run_msfem("export-load " + coarse_sphere_args + setting + " " +
+                        path("load_" + name).string())
                   .exit_code,
               0);
     const std::string answer = path("stand_in_" + name + ".vtu").string();
@@ -138,7 +142,7 @@ TEST_F(ExternalResults, ASecondProgramsAnswerFromTheExportedLoadsIsMeasuredAsThe
                            path("load_" + name).string() + " " + answer)
                               .c_str()),
               0);
-    const auto r = run_msfem("run " + sphere + setting +
+    const auto r = run_msfem("run " + coarse_sphere_args + setting +
                              " --quiet --no-timing --set 'mass spring/variants=single_layer'"
                              " --set 'mass spring/results=sim=" +
                              answer + "' --out " + path("stand_in_run_" + name).string());
@@ -155,15 +159,15 @@ TEST_F(ExternalResults, ASecondProgramsAnswerFromTheExportedLoadsIsMeasuredAsThe
 
 TEST_F(ExternalResults, AnAnswerTenPercentWorseFailsRegress) {
   const std::string baselines = " --baselines " + path("baselines").string();
-  ASSERT_EQ(run_msfem("regress " + sphere + " --quiet --update" + baselines +
+  ASSERT_EQ(run_msfem("regress " + coarse_sphere_args + " --quiet --update" + baselines +
                       results("sim=" + path("fem.vtu").string()))
                 .exit_code,
             0);
-  EXPECT_EQ(run_msfem("regress " + sphere + " --quiet" + baselines +
+  EXPECT_EQ(run_msfem("regress " + coarse_sphere_args + " --quiet" + baselines +
                       results("sim=" + path("fem.vtu").string()))
                 .exit_code,
             0);
-  const auto worse = run_msfem("regress " + sphere + " --quiet" + baselines +
+  const auto worse = run_msfem("regress " + coarse_sphere_args + " --quiet" + baselines +
                                results("sim=" + path("worse.vtu").string()));
   EXPECT_EQ(worse.exit_code, 1) << worse.out << worse.err;
   EXPECT_NE(worse.out.find("WORSE"), std::string::npos) << worse.out;
@@ -202,7 +206,7 @@ TEST_F(ExternalResults, BadResultFilesAreRefusedNamingTheFileAndItem) {
       {"version.vtu", "schema version 2"}};
   for (const auto& [file, expected] : cases) {
     const auto out = path("refused_" + file);
-    const auto r = run_msfem("run " + sphere + " --quiet --no-timing" +
+    const auto r = run_msfem("run " + coarse_sphere_args + " --quiet --no-timing" +
                              results("sim=" + path(file).string()) + " --out " + out.string());
     EXPECT_EQ(r.exit_code, 2) << file;
     // The result file, or the force file beside it.
@@ -214,7 +218,7 @@ TEST_F(ExternalResults, BadResultFilesAreRefusedNamingTheFileAndItem) {
   }
   // One file per load.
   const auto two =
-      run_msfem("run " + sphere + " --quiet --no-timing" +
+      run_msfem("run " + coarse_sphere_args + " --quiet --no-timing" +
                 results("sim=" + path("fem.vtu").string() + "," + path("fem.vtu").string()));
   EXPECT_EQ(two.exit_code, 2);
   EXPECT_NE(two.err.find("2 files for the case's 1 loads"), std::string::npos) << two.err;

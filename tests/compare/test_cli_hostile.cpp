@@ -18,7 +18,7 @@ using testing::run_msfem;
 using testing::TemporaryDirectory;
 
 const std::string cases_dir = MSFEM_CASES_DIR;
-const std::string sphere = cases_dir + "/sphere_indent.prm";
+const std::string sphere_indent_case = cases_dir + "/sphere_indent.prm";
 
 struct Hostile {
   const char* name;
@@ -81,76 +81,82 @@ const Hostile hostile[] = {
     {"KeySetTwice", "run {dir}/twice.prm", "twice.prm:3: 'material/youngs modulus' is set twice"},
     {"EmptyCaseFile", "run {dir}/empty.prm", "empty.prm: the case file is empty"},
     {"DirectoryAsCase", "run {dir}", "is a directory"},
-    {"CellSizeThatWouldMeshForever", "run " + sphere + " --set 'fem/cell size=1e-4'",
+    {"CellSizeThatWouldMeshForever", "run " + sphere_indent_case + " --set 'fem/cell size=1e-4'",
      "fem/cell size 0.0001 m would mesh about"},
-    {"MisspelledGroupScale", "run " + sphere + " --set 'mass spring/group scales=tier1_edgez:2'",
+    {"MisspelledGroupScale",
+     "run " + sphere_indent_case + " --set 'mass spring/group scales=tier1_edgez:2'",
      "mass spring/group scales: no variant of the case has a group 'tier1_edgez'"},
-    {"VolumeScaleWithoutVolume", "run " + sphere + " --set 'mass spring/group scales=volume:2'",
+    {"VolumeScaleWithoutVolume",
+     "run " + sphere_indent_case + " --set 'mass spring/group scales=volume:2'",
      "volume preservation = true"},
-    {"AbsurdModulus", "run " + sphere + " --set 'material/youngs modulus=1e300'",
+    {"AbsurdModulus", "run " + sphere_indent_case + " --set 'material/youngs modulus=1e300'",
      "material/youngs modulus=1e300"},
-    {"SimplifyAboveTheVertexCount", "run " + sphere + " --set 'geometry/simplify to vertices=5000'",
+    {"SimplifyAboveTheVertexCount",
+     "run " + sphere_indent_case + " --set 'geometry/simplify to vertices=5000'",
      "geometry/simplify to vertices = 5000 is more than the 642 vertices"},
     {"MoreControlPointsThanVertices",
-     "run " + sphere + " --set 'mass spring/skeleton/control points=5000'",
+     "run " + sphere_indent_case + " --set 'mass spring/skeleton/control points=5000'",
      "mass spring/skeleton/control points = 5000"},
-    {"FixedRegionCatchingNoNode", "run " + sphere + " --set 'support/inner core scale=50'",
+    {"FixedRegionCatchingNoNode",
+     "run " + sphere_indent_case + " --set 'support/inner core scale=50'",
      "support/fixed region: it catches no node"},
     // Under gravity alone, a fixed ball that holds no mesh node: the FEM would be singular (an
     // iterative solver's fallback once returned 44 mm on a 50 mm sphere for such a case).
     {"SingularFemFromATinyFixedRegion",
-     "run " + sphere +
+     "run " + sphere_indent_case +
          " --set loads/tool/enabled=false --set 'loads/gravity=0,0,-9.81' --set 'support/fixed "
          "region=sphere' --set 'support/sphere radius=1e-4'",
      "support/fixed region"},
-    {"UnknownIntegrator", "run " + sphere + " --set 'timing/integrator=verlet'", "verlet"},
-    {"PathStepThatWouldPressForever", "run " + sphere + " --set 'loads/tool/path step=1e-9'",
-     "loads/tool/path step"},
-    {"ErrorEstimateDegreeAtP2", "run " + sphere + " --set 'fem/error estimate=degree'",
+    {"UnknownIntegrator", "run " + sphere_indent_case + " --set 'timing/integrator=verlet'",
+     "verlet"},
+    {"PathStepThatWouldPressForever",
+     "run " + sphere_indent_case + " --set 'loads/tool/path step=1e-9'", "loads/tool/path step"},
+    {"ErrorEstimateDegreeAtP2", "run " + sphere_indent_case + " --set 'fem/error estimate=degree'",
      "fem/error estimate = degree needs fem/degree = 1"},
-    {"UnknownFitGroup", "calibrate " + sphere + " --fit nope", "has no group 'nope'"},
+    {"UnknownFitGroup", "calibrate " + sphere_indent_case + " --fit nope", "has no group 'nope'"},
     {"HeldOutLoadOnATrainingVertex",
-     "calibrate " + sphere + " --train '0,0,1@0.005' --test '0,0.001,1@0.005'",
+     "calibrate " + sphere_indent_case + " --train '0,0,1@0.005' --test '0,0.001,1@0.005'",
      "presses the same surface vertex"},
-    {"EmptyOutPath", "run " + sphere + " --out ''", "empty path"},
+    {"EmptyOutPath", "run " + sphere_indent_case + " --out ''", "empty path"},
     // Numbers each key accepts alone that the case makes meaningless, refused before the FEM.
-    {"ToolDepthAtRoundOff", "run " + sphere + " --set loads/tool/depth=1e-7",
+    {"ToolDepthAtRoundOff", "run " + sphere_indent_case + " --set loads/tool/depth=1e-7",
      "loads/tool/depth = 1e-07 m is below"},
-    {"ToolDepthOfADenormal", "run " + sphere + " --set loads/tool/depth=1e-300",
+    {"ToolDepthOfADenormal", "run " + sphere_indent_case + " --set loads/tool/depth=1e-300",
      "loads/tool/depth = 1e-300 m is below"},
-    {"CurveDepthZero", "run " + sphere + " --set 'loads/tool/curve depths=0,0.005'",
+    {"CurveDepthZero", "run " + sphere_indent_case + " --set 'loads/tool/curve depths=0,0.005'",
      "loads/tool/curve depths = 0 m is below"},
-    {"GravityOfAThousandG", "run " + sphere + " --set 'loads/gravity=0,0,-1e4'",
+    {"GravityOfAThousandG", "run " + sphere_indent_case + " --set 'loads/gravity=0,0,-1e4'",
      "loads/gravity would move the surface about"},
     {"PatchForceOfAMegaNewton",
-     "run " + sphere +
+     "run " + sphere_indent_case +
          " --set 'loads/patch force/enabled=true' --set 'loads/patch force/force=1e6,0,0'",
      "loads/patch force/force would move the surface about"},
-    {"TimeStepAtRoundOff", "run " + sphere + " --set timing/dt=1e-300",
+    {"TimeStepAtRoundOff", "run " + sphere_indent_case + " --set timing/dt=1e-300",
      "timing/dt = 1e-300 s is below"},
     {"HuTableOfADenormalModulus",
-     "run " + sphere + " --set 'material/youngs modulus image=" + cases_dir +
+     "run " + sphere_indent_case + " --set 'material/youngs modulus image=" + cases_dir +
          "/data/abdomen_ct_3mm.nii.gz' --set 'material/hu to youngs=0:1e-300; 100:3000'",
      "material/hu to youngs: 0:1e-300 gives E outside"},
     {"HuTableOfNoContrastLimit",
-     "run " + sphere + " --set 'material/youngs modulus image=" + cases_dir +
+     "run " + sphere_indent_case + " --set 'material/youngs modulus image=" + cases_dir +
          "/data/abdomen_ct_3mm.nii.gz' --set 'material/hu to youngs=0:0.01; 100:1e11'",
      "a contrast above"},
     // Settings that would be ignored.
-    {"HuTableWithoutImage", "run " + sphere + " --set 'material/hu to youngs=0:3000; 100:5000'",
+    {"HuTableWithoutImage",
+     "run " + sphere_indent_case + " --set 'material/hu to youngs=0:3000; 100:5000'",
      "material/hu to youngs is set but material/youngs modulus image is empty"},
     {"RefinementSizeWithRefinementOff",
-     "run " + sphere + " --set 'mass spring/contact refinement/edge length=0.001'",
+     "run " + sphere_indent_case + " --set 'mass spring/contact refinement/edge length=0.001'",
      "contact refinement: radius or edge length is set but enabled = false"},
     {"VolumePreservationWithoutVolumeElements",
-     "run " + sphere +
+     "run " + sphere_indent_case +
          " --set 'mass spring/variants=single_layer' --set 'mass spring/volume preservation=true'",
      "none of mass spring/variants has volume elements"},
-    {"UnitOfAGeneratedSurface", "run " + sphere + " --set geometry/unit=mm",
+    {"UnitOfAGeneratedSurface", "run " + sphere_indent_case + " --set geometry/unit=mm",
      "geometry/unit = mm has no effect on a generated surface"},
-    {"SweepOfNoResolution", "sweep " + sphere + " --resolutions ''",
+    {"SweepOfNoResolution", "sweep " + sphere_indent_case + " --resolutions ''",
      "option --resolutions: '' lists no value"},
-    {"RepeatedOption", "sweep " + sphere + " --resolutions 2 --resolutions 3",
+    {"RepeatedOption", "sweep " + sphere_indent_case + " --resolutions 2 --resolutions 3",
      "option --resolutions is given twice"},
     {"BenchOnAHundredThousandThreads", "bench massspring --threads 100000",
      "option --threads 100000 is outside [1, 256]"},
@@ -208,7 +214,7 @@ TEST(CliInterface, ThePrintedDefaultsRun) {
 // A surface read in the wrong unit solves without error: msfem warns when it is not organ-sized.
 TEST(CliInterface, ASurfaceInTheWrongUnitIsWarnedAbout) {
   TemporaryDirectory dir;
-  const auto r = run_msfem("run " + sphere + " --set 'geometry/source=" + cases_dir +
+  const auto r = run_msfem("run " + sphere_indent_case + " --set 'geometry/source=" + cases_dir +
                            "/data/pancreas_vh_female_m.obj' --set geometry/unit=mm --out " +
                            (dir / "run").string());
   EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;

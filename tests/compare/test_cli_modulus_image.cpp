@@ -12,9 +12,8 @@ namespace {
 using testing::count_lines;
 using testing::read_text;
 using testing::run_msfem;
+using testing::small_sphere_case;
 using testing::TemporaryDirectory;
-
-const std::string small_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm";
 
 // 12³ voxels of 10 mm about the origin (the 5 cm sphere with room), HU from `hu` of the world
 // position in mm.
@@ -34,7 +33,7 @@ std::string write_ct(const TemporaryDirectory& dir, const std::string& name, Hu 
 
 nlohmann::json run_summary(const TemporaryDirectory& dir, const std::string& name,
                            const std::string& sets) {
-  const auto r = run_msfem("run " + small_case + " --quiet --no-timing --no-cache --out " +
+  const auto r = run_msfem("run " + small_sphere_case + " --quiet --no-timing --no-cache --out " +
                            (dir / name).string() + sets);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   return nlohmann::json::parse(read_text(dir / name / "summary.json"));
@@ -113,7 +112,7 @@ TEST(CliModulusImage, BadImagesAndTablesAreOneLineNamingTheKeyAndWriteNothing) {
   for (const auto& [sets, named] : bad) {
     const auto out = dir / "out";
     const auto r =
-        run_msfem("run " + small_case + " --quiet --no-cache --out " + out.string() + sets);
+        run_msfem("run " + small_sphere_case + " --quiet --no-cache --out " + out.string() + sets);
     EXPECT_EQ(r.exit_code, 2) << sets << ": " << r.err;
     EXPECT_EQ(count_lines(r.err), 1u) << r.err;
     EXPECT_NE(r.err.find(named), std::string::npos) << r.err;

@@ -16,9 +16,8 @@ namespace {
 using testing::count_lines;
 using testing::read_text;
 using testing::run_msfem;
+using testing::small_sphere_case;
 using testing::TemporaryDirectory;
-
-const std::string small_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm";
 
 void expect_finite_numbers(const nlohmann::json& j, const std::string& where) {
   if (j.is_number()) {
@@ -37,8 +36,8 @@ class RunSmallSphere : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TemporaryDirectory();
-    result_ = new testing::CommandResult(
-        run_msfem("run " + small_case + " --quiet --out " + (dir_->path() / "run").string()));
+    result_ = new testing::CommandResult(run_msfem("run " + small_sphere_case + " --quiet --out " +
+                                                   (dir_->path() / "run").string()));
   }
   static void TearDownTestSuite() {
     delete result_;
@@ -152,7 +151,7 @@ TEST_F(RunSmallSphere, SpringNetworkBeatsSingleLayerAtCauchyPoissonRatio) {
 
 TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
   TemporaryDirectory tmp;
-  const std::string base = read_text(small_case);
+  const std::string base = read_text(small_sphere_case);
   auto write_case = [&](const std::string& name, const std::string& text) {
     std::ofstream(tmp / name) << text;
     return (tmp / name).string();
@@ -184,8 +183,8 @@ TEST(CliRun, BadInputIsOneLineWithFileAndLineAndLeavesNoRunFolder) {
     for (const auto& entry : std::filesystem::directory_iterator(tmp.path()))
       EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
   }
-  const auto bad_set = run_msfem("run " + small_case + " --quiet --out " + (tmp / "o").string() +
-                                 " --set 'mass spring/variants=four_tier'");
+  const auto bad_set = run_msfem("run " + small_sphere_case + " --quiet --out " +
+                                 (tmp / "o").string() + " --set 'mass spring/variants=four_tier'");
   EXPECT_EQ(bad_set.exit_code, 2);
   EXPECT_NE(bad_set.err.find("four_tier"), std::string::npos) << bad_set.err;
 }
@@ -195,7 +194,7 @@ TEST(CliRun, AnInterruptedRunLeavesNeitherItsFolderNorItsTemporary) {
   const auto out = tmp / "run";
   // Start a run, wait until its temporary folder exists, then send SIGTERM as a batch system would.
   const std::string script =
-      std::string(MSFEM_EXECUTABLE) + " run " + small_case + " --quiet --no-cache --out " +
+      std::string(MSFEM_EXECUTABLE) + " run " + small_sphere_case + " --quiet --no-cache --out " +
       out.string() + " >/dev/null 2>&1 & pid=$!; for i in $(seq 1 300); do " + "ls -d " +
       out.string() + ".tmp.* >/dev/null 2>&1 && break; sleep 0.02; done; kill -TERM $pid; " +
       "wait $pid; echo $? >" + (tmp / "status").string();
@@ -214,7 +213,8 @@ TEST(CliRun, AFolderAnotherRunIsFillingIsRefusedAtOnce) {
   TemporaryDirectory tmp;
   const auto out = tmp / "run";
   std::ofstream(tmp / "run.lock") << ::getpid() << "\n";
-  const auto taken = run_msfem("run " + small_case + " --quiet --no-timing --out " + out.string());
+  const auto taken =
+      run_msfem("run " + small_sphere_case + " --quiet --no-timing --out " + out.string());
   EXPECT_EQ(taken.exit_code, 2) << taken.err;
   EXPECT_NE(taken.err.find("another msfem (process " + std::to_string(::getpid()) +
                            ") is writing this output folder"),
@@ -223,8 +223,8 @@ TEST(CliRun, AFolderAnotherRunIsFillingIsRefusedAtOnce) {
   EXPECT_EQ(taken.err.find("solving the FEM"), std::string::npos) << taken.err;
   EXPECT_FALSE(std::filesystem::exists(out));
   std::ofstream(tmp / "run.lock") << "4194303\n";  // above Linux's largest process id
-  const auto stale =
-      run_msfem("run " + small_case + " --quiet --no-timing --no-curve --out " + out.string());
+  const auto stale = run_msfem("run " + small_sphere_case +
+                               " --quiet --no-timing --no-curve --out " + out.string());
   EXPECT_EQ(stale.exit_code, 0) << stale.err;
   EXPECT_TRUE(std::filesystem::exists(out / "summary.json"));
   EXPECT_FALSE(std::filesystem::exists(tmp / "run.lock"));
@@ -235,7 +235,7 @@ TEST(CliRun, AVariantThatFailsIsReportedAndTheOthersAreStillCompared) {
   // below the surface variants' (2.3-2.5 ms), so only tet_edges' time stepping blows up.
   TemporaryDirectory tmp;
   const auto out = tmp / "run";
-  const auto r = run_msfem("run " + small_case +
+  const auto r = run_msfem("run " + small_sphere_case +
                            " --quiet --no-curve --set timing/dt=0.0015 --out " + out.string());
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("variant tet_edges failed"), std::string::npos) << r.err;
@@ -254,7 +254,7 @@ TEST(CliRun, AVariantThatFailsIsReportedAndTheOthersAreStillCompared) {
 TEST(CliRun, PathStepsArePointsOfEachVariantsCurveAndTheLastIsTheTablesRow) {
   TemporaryDirectory tmp;
   const auto out = tmp / "run";
-  const auto r = run_msfem("run " + small_case +
+  const auto r = run_msfem("run " + small_sphere_case +
                            " --quiet --no-timing --set \"loads/tool/path step=0.0005\" --set "
                            "\"mass spring/variants=tet_edges,three_tier\" --out " +
                            out.string());
@@ -282,7 +282,7 @@ TEST(CliRun, EveryToolPositionIsItsOwnLoadAndCentralSymmetryHoldsAcrossThem) {
   TemporaryDirectory tmp;
   const auto out = tmp / "run";
   const auto r = run_msfem(
-      "run " + small_case +
+      "run " + small_sphere_case +
       " --quiet --no-timing --set \"loads/tool/directions=0,1,1.618034; "
       "0,-1,-1.618034; 1.618034,0,1\" --set \"mass spring/variants=three_tier,tet_edges\" "
       "--out " +
@@ -326,7 +326,7 @@ TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
   TemporaryDirectory tmp;
   const std::string variants = " --set \"mass spring/variants=three_tier,single_layer\"";
   const auto contact =
-      run_msfem("run " + small_case + " --quiet --no-timing --no-cache" + variants +
+      run_msfem("run " + small_sphere_case + " --quiet --no-timing --no-cache" + variants +
                 " --set loads/tool/mode=contact --out " + (tmp / "contact").string());
   ASSERT_EQ(contact.exit_code, 0) << contact.err;
   const auto j = nlohmann::json::parse(read_text(tmp / "contact" / "summary.json"));
@@ -348,8 +348,9 @@ TEST(CliRun, ContactModePressesBothModelsByFrictionlessContact) {
     EXPECT_GT(v["reaction_force_N"][2].get<double>(), 0.0) << v["name"];
     EXPECT_TRUE(v["force_depth_exponent"].is_number()) << v["name"];
   }
-  const auto bonded = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" + variants +
-                                " --set loads/tool/mode=bonded --out " + (tmp / "bonded").string());
+  const auto bonded =
+      run_msfem("run " + small_sphere_case + " --quiet --no-timing --no-cache" + variants +
+                " --set loads/tool/mode=bonded --out " + (tmp / "bonded").string());
   ASSERT_EQ(bonded.exit_code, 0) << bonded.err;
   const auto b = nlohmann::json::parse(read_text(tmp / "bonded" / "summary.json"));
   EXPECT_EQ(b["tools"][0]["mode"], "bonded");
@@ -386,7 +387,7 @@ TEST(CliRun, AContactToolWithOneCurveDepthIsPressedAsTheDefaultPathPressesIt) {
 // vertices first, every variant following it, and the counts in summary.json.
 TEST(CliRun, ContactRefinementRefinesTheSurfaceEveryModelIsBuiltOn) {
   TemporaryDirectory tmp;
-  const auto r = run_msfem("run " + small_case + " --quiet --no-timing --no-cache" +
+  const auto r = run_msfem("run " + small_sphere_case + " --quiet --no-timing --no-cache" +
                            " --set \"mass spring/variants=three_tier,single_layer\"" +
                            " --set \"mass spring/contact refinement/enabled=true\"" + " --out " +
                            (tmp / "refined").string());
@@ -413,7 +414,7 @@ TEST(CliRun, ContactRefinementRefinesTheSurfaceEveryModelIsBuiltOn) {
 
   // Without a tool there is nothing to refine around: a clear error, nothing written.
   const auto no_tool = run_msfem(
-      "run " + small_case + " --quiet --no-timing --no-cache" +
+      "run " + small_sphere_case + " --quiet --no-timing --no-cache" +
       " --set \"mass spring/contact refinement/enabled=true\"" + " --set loads/tool/enabled=false" +
       " --set \"loads/gravity=0,0,-9.81\" --out " + (tmp / "no_tool").string());
   EXPECT_EQ(no_tool.exit_code, 2) << no_tool.err;
@@ -453,7 +454,7 @@ std::string write_u_shape(const std::filesystem::path& file) {
 TEST(CliRun, ContactToolStartingInsideAConcaveSurfaceIsRefused) {
   TemporaryDirectory tmp;
   const std::string u = write_u_shape(tmp / "u.obj");
-  const std::string common = "run " + small_case + " --quiet --no-timing --no-cache" +
+  const std::string common = "run " + small_sphere_case + " --quiet --no-timing --no-cache" +
                              " --set loads/tool/mode=contact --set geometry/source=" + u +
                              " --set \"support/fixed region=half space\"" +
                              " --set \"support/half space point=0,0,0.002\"";
@@ -485,7 +486,7 @@ TEST(CliParams, PrintsTheWholeLanguage) {
 // same equilibrium, and msfem regress (which runs that way) measures what msfem run prints.
 TEST(RunOptions, NoCurveGivesTheSameEquilibrium) {
   TemporaryDirectory dir;
-  const std::string common = "run " + small_case + " --quiet --no-timing --no-cache --out ";
+  const std::string common = "run " + small_sphere_case + " --quiet --no-timing --no-cache --out ";
   const auto full = run_msfem(common + (dir / "full").string());
   const auto lean = run_msfem(common + (dir / "lean").string() + " --no-curve");
   ASSERT_EQ(full.exit_code, 0) << full.err;
@@ -511,7 +512,7 @@ TEST(RunOptions, NoCurveGivesTheSameEquilibrium) {
 // the very numbers it had; the same run again reads every load from the cache.
 TEST(RunOptions, EachLoadsReferenceIsCachedOnItsOwn) {
   TemporaryDirectory dir;
-  const std::string common = "run " + small_case + " --quiet --no-timing" +
+  const std::string common = "run " + small_sphere_case + " --quiet --no-timing" +
                              " --set \"loads/tool/directions=0,0,1; 1,0,0\"" +
                              " --set \"mass spring/variants=three_tier\" --out ";
   const auto first = run_msfem(common + (dir / "first").string());

@@ -11,16 +11,15 @@ namespace {
 
 using testing::read_text;
 using testing::run_msfem;
+using testing::small_sphere_case;
 using testing::TemporaryDirectory;
-
-const std::string small_case = std::string(MSFEM_TEST_DATA_DIR) + "/small_sphere.prm";
 
 TEST(CliSweep, AResolutionThatCannotBeRunIsReportedAndTheOthersAreStillSwept) {
   // Icosphere level 10 is out of range: as a surface that self-intersects once simplified (the
   // brain below ~2,500 vertices) it is bad input at that resolution only.
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
-  const auto r = run_msfem("sweep " + small_case +
+  const auto r = run_msfem("sweep " + small_sphere_case +
                            " --quiet --resolutions 1,10 --integrators symplectic_euler "
                            "--max-error 10 --out " +
                            out.string());
@@ -50,7 +49,7 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
   const auto r =
-      run_msfem("sweep " + small_case +
+      run_msfem("sweep " + small_sphere_case +
                 " --quiet --resolutions 1 --integrators symplectic_euler "
                 "--volume-preservation both --set \"material/poisson ratio=0.45\" --out " +
                 out.string());
@@ -71,8 +70,9 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
   }
   EXPECT_EQ(errors["single_layer"].size(), 1u);
   EXPECT_NE(read_text(out / "report.md").find("three_tier+volume"), std::string::npos);
-  const auto bad = run_msfem("sweep " + small_case + " --quiet --volume-preservation maybe --out " +
-                             (tmp / "bad").string());
+  const auto bad =
+      run_msfem("sweep " + small_sphere_case + " --quiet --volume-preservation maybe --out " +
+                (tmp / "bad").string());
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_NE(bad.err.find("--volume-preservation"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
@@ -83,7 +83,7 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
 TEST(CliSweep, ContactRefinementIsSweptAtEachEdgeLength) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
-  const auto r = run_msfem("sweep " + small_case +
+  const auto r = run_msfem("sweep " + small_sphere_case +
                            " --quiet --resolutions 1 --integrators symplectic_euler "
                            "--set \"mass spring/variants=single_layer\" --contact-refinement both "
                            "--contact-edge-lengths 0.006,0.003 --out " +
@@ -106,8 +106,8 @@ TEST(CliSweep, ContactRefinementIsSweptAtEachEdgeLength) {
         "--contact-edge-lengths -0.001",
         "--contact-refinement on --set \"loads/tool/enabled=false\" --set "
         "\"loads/gravity=0,0,-9.81\""}) {
-    const auto refused =
-        run_msfem("sweep " + small_case + " --quiet " + bad + " --out " + (tmp / "bad").string());
+    const auto refused = run_msfem("sweep " + small_sphere_case + " --quiet " + bad + " --out " +
+                                   (tmp / "bad").string());
     EXPECT_EQ(refused.exit_code, 2) << bad << ": " << refused.err;
     EXPECT_NE(refused.err.find("--contact-"), std::string::npos) << refused.err;
     EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
@@ -143,8 +143,8 @@ TEST(CliSweep, AMaximumErrorThatIsNotAPositiveNumberIsRefusedBeforeAnySolve) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
   for (const char* bad : {"0", "-0.1", "abc", "0.2x", "nan"}) {
-    const auto r =
-        run_msfem("sweep " + small_case + " --quiet --max-error " + bad + " --out " + out.string());
+    const auto r = run_msfem("sweep " + small_sphere_case + " --quiet --max-error " + bad +
+                             " --out " + out.string());
     EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
     EXPECT_NE(r.err.find("--max-error"), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(out));
@@ -155,7 +155,7 @@ TEST(CliSweep, WhenNoResolutionCanBeRunItIsAnErrorAndNothingIsWritten) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
   const auto r =
-      run_msfem("sweep " + small_case + " --quiet --resolutions 10 --out " + out.string());
+      run_msfem("sweep " + small_sphere_case + " --quiet --resolutions 10 --out " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("level '10'"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));

@@ -31,10 +31,6 @@ namespace {
 namespace ms = msfem::massspring;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 ms::SpringNetwork build_network(cases::Variant variant, const Problem& problem,
                                 const fem_reference::VolumeMesh& mesh) {
   ms::Material material;

@@ -38,23 +38,13 @@ std::string gnuplot_palette() {
   return text + ")\n";
 }
 
+using detail::number;
+using detail::quoted;
+
 Eigen::Vector3d any_perpendicular(const Eigen::Vector3d& n) {
   const Eigen::Vector3d other =
       std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   return n.cross(other).normalized();
-}
-
-std::string number(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", x);
-  return text;
-}
-
-std::string quoted(const std::string& text) {
-  std::string out = "'";
-  for (const char c : text)
-    out += c == '\'' ? std::string("''") : std::string(1, c == '\n' ? ' ' : c);
-  return out + "'";
 }
 
 // The triangles in camera coordinates, each as a pm3d patch of two scans (a b / c c) with its

@@ -15,4 +15,10 @@ std::filesystem::path render(const std::filesystem::path& requested, const std::
                              const std::string& commands, int width = 900, int height = 600,
                              const std::vector<std::string>& more_data = {});
 
+/// A gnuplot single-quoted string: literal except that '' stands for '; line breaks become spaces.
+std::string quoted(const std::string& text);
+
+/// A number as gnuplot reads it back to the last bit.
+std::string number(double value);
+
 }  // namespace msfem::compare::detail

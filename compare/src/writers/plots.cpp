@@ -111,8 +111,10 @@ bool gnuplot_has_pngcairo() {
   return has;
 }
 
-// A gnuplot single-quoted string: literal except that '' stands for '. Line breaks would end the
-// command, so they become spaces.
+}  // namespace
+
+namespace detail {
+
 std::string quoted(const std::string& text) {
   std::string out = "'";
   for (char c : text) {
@@ -131,6 +133,13 @@ std::string number(double value) {
   std::snprintf(buffer, sizeof buffer, "%.17g", value);
   return buffer;
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::number;
+using detail::quoted;
 
 struct OutputFormat {
   fs::path path;
