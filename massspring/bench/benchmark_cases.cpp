@@ -123,11 +123,10 @@ std::vector<BenchmarkCase> benchmark_cases(const std::optional<Eigen::MatrixX3d>
   return cases;
 }
 
-SteppingBenchmarkResult run_benchmark_case(const BenchmarkCase& benchmark_case,
-                                           const SteppingBenchmarkOptions& options) {
-  if (benchmark_case.model) return run_stepping_benchmark(*benchmark_case.model, options);
-  MassSpringModel model(benchmark_case.network);
-  SteppingBenchmarkResult result;
+std::unique_ptr<MassSpringModel> benchmark_model(const BenchmarkCase& benchmark_case,
+                                                 std::string* note) {
+  if (benchmark_case.model) return std::make_unique<MassSpringModel>(*benchmark_case.model);
+  auto model = std::make_unique<MassSpringModel>(benchmark_case.network);
   if (benchmark_case.volume_preservation) {
     const SpringNetwork& n = benchmark_case.network;
     const int per_tier = n.num_nodes() / 3;
@@ -135,13 +134,22 @@ SteppingBenchmarkResult run_benchmark_case(const BenchmarkCase& benchmark_case,
                                           volume_modulus_for(3000.0, 0.45));
     const int all = elements.num_elements();
     const int removed = remove_degenerate_elements(elements, n.rest_positions, 1e-3);
-    model.set_volume(VolumeForceField(model.num_nodes(), std::move(elements)));
-    result = run_stepping_benchmark(model, options);
-    result.notes.push_back(std::to_string(all - removed) + " volume elements (" +
-                           std::to_string(removed) + " inverted or flat at rest left out)");
-    return result;
+    model->set_volume(VolumeForceField(model->num_nodes(), std::move(elements)));
+    if (note)
+      *note = std::to_string(all - removed) + " volume elements (" + std::to_string(removed) +
+              " inverted or flat at rest left out)";
   }
-  return run_stepping_benchmark(model, options);
+  return model;
+}
+
+SteppingBenchmarkResult run_benchmark_case(const BenchmarkCase& benchmark_case,
+                                           const SteppingBenchmarkOptions& options) {
+  if (benchmark_case.model) return run_stepping_benchmark(*benchmark_case.model, options);
+  std::string note;
+  const std::unique_ptr<MassSpringModel> model = benchmark_model(benchmark_case, &note);
+  SteppingBenchmarkResult result = run_stepping_benchmark(*model, options);
+  if (!note.empty()) result.notes.push_back(note);
+  return result;
 }
 
 }  // namespace msfem::massspring

@@ -21,35 +21,30 @@ namespace {
 
 using namespace msfem::massspring;
 
-// Models are built once per case and kept for all benchmarks of the run.
-const MassSpringModel& model_for(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<MassSpringModel>> models;
-  if (models.empty()) {
+const std::vector<BenchmarkCase>& all_cases() {
+  static const std::vector<BenchmarkCase> cases = [] {
     std::optional<Eigen::MatrixX3d> brain_vertices;
     std::optional<Eigen::MatrixX3i> brain_triangles;
     if (auto brain = bench::read_obj(MSFEM_BRAIN_OBJ, 1e-3)) {
       brain_vertices = brain->vertices;
       brain_triangles = brain->triangles;
     }
-    for (auto& c : benchmark_cases(brain_vertices, brain_triangles)) {
-      auto model = std::make_unique<MassSpringModel>(c.network);
-      models.emplace(c.name, std::move(model));
-    }
-  }
-  return *models.at(name);
+    return benchmark_cases(brain_vertices, brain_triangles);
+  }();
+  return cases;
 }
 
-// The same model with volume preservation on its shell prisms, as msfem bench's *_volume case.
-const MassSpringModel& volume_model_for(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<MassSpringModel>> models;
-  auto& model = models[name];
+// Models are built once per case (and once more with volume preservation where asked) and kept
+// for all benchmarks of the run; the volume model is msfem bench's *_volume case of that network.
+const MassSpringModel& model_for(const std::string& name, bool volume = false) {
+  static std::map<std::pair<std::string, bool>, std::unique_ptr<MassSpringModel>> models;
+  auto& model = models[{name, volume}];
   if (!model) {
-    model = std::make_unique<MassSpringModel>(model_for(name).network());
-    const SpringNetwork& n = model->network();
-    VolumeElements elements = tier_prisms(n.rest_positions, n.surface_triangles, n.num_nodes() / 3,
-                                          3, volume_modulus_for(3000.0, 0.45));
-    remove_degenerate_elements(elements, n.rest_positions, 1e-3);
-    model->set_volume(VolumeForceField(model->num_nodes(), std::move(elements)));
+    for (BenchmarkCase c : all_cases())
+      if (c.name == name) {
+        c.volume_preservation = c.volume_preservation || volume;
+        model = benchmark_model(c);
+      }
   }
   return *model;
 }
@@ -88,7 +83,7 @@ void naive_step(benchmark::State& state, const std::string& name) {
 // the counter `threads` is the mean number the steps ran on.
 void implicit_step(benchmark::State& state, const std::string& name, bool single_precision,
                    double tolerance, int threads, bool adaptive_threads, bool volume) {
-  const MassSpringModel& model = volume ? volume_model_for(name) : model_for(name);
+  const MassSpringModel& model = model_for(name, volume);
   FastImplicitOptions options{threads, true, tolerance, 50, single_precision, adaptive_threads};
   FastImplicitStepper stepper(model, options);
   stepper.set_state(perturbed_start(model));

@@ -45,6 +45,12 @@ std::vector<BenchmarkCase> benchmark_cases(const std::optional<Eigen::MatrixX3d>
                                            const std::optional<Eigen::MatrixX3i>& brain_triangles,
                                            bool include_10x = true);
 
+/// A case's model: its network, with volume preservation on the shell prisms where the case asks
+/// for it (those inverted or flat at rest left out; `note`, where given, says how many were kept).
+/// A case that carries a model built elsewhere gets a copy of it.
+std::unique_ptr<MassSpringModel> benchmark_model(const BenchmarkCase& benchmark_case,
+                                                 std::string* note = nullptr);
+
 /// Builds the model of a case and runs the stepping benchmark on it.
 SteppingBenchmarkResult run_benchmark_case(const BenchmarkCase& benchmark_case,
                                            const SteppingBenchmarkOptions& options = {});
