@@ -4,20 +4,17 @@
 #include <cmath>
 #include <sstream>
 
+#include "model/number_text.hpp"
 #include "msfem/massspring/errors.hpp"
 
 namespace msfem::massspring {
 namespace {
 
-std::string num(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
+using detail::number_text;
 
 void check_non_negative(double value, const std::string& item) {
   if (!(value >= 0.0) || !std::isfinite(value))
-    throw ModelError(item + ": " + num(value) + " must be finite and >= 0");
+    throw ModelError(item + ": " + number_text(value) + " must be finite and >= 0");
 }
 
 }  // namespace
@@ -117,7 +114,7 @@ void MassSpringModel::set_damping(const Eigen::VectorXd& damping) {
 void MassSpringModel::set_node_group_mass(const std::string& group, double mass_per_node) {
   const int id = network_.node_group_id(group);
   if (!(mass_per_node > 0.0) || !std::isfinite(mass_per_node))
-    throw ModelError("node group '" + group + "' mass " + num(mass_per_node) +
+    throw ModelError("node group '" + group + "' mass " + number_text(mass_per_node) +
                      " must be finite and > 0");
   for (int i = 0; i < num_nodes(); ++i)
     if (network_.node_group[i] == id) network_.masses[i] = mass_per_node;
@@ -129,7 +126,7 @@ void MassSpringModel::set_masses(const Eigen::VectorXd& masses) {
                      std::to_string(num_nodes()) + " nodes");
   for (Eigen::Index i = 0; i < masses.size(); ++i)
     if (!(masses[i] > 0.0) || !std::isfinite(masses[i]))
-      throw ModelError("node " + std::to_string(i) + ": mass " + num(masses[i]) +
+      throw ModelError("node " + std::to_string(i) + ": mass " + number_text(masses[i]) +
                        " must be finite and > 0");
   network_.masses = masses;
 }

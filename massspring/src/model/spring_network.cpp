@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "model/number_text.hpp"
 #include "msfem/massspring/errors.hpp"
 
 namespace msfem::massspring {
@@ -12,11 +13,7 @@ namespace {
   throw ModelError(item + ": " + what);
 }
 
-std::string num(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
+using detail::number_text;
 
 void check_size(Eigen::Index actual, Eigen::Index expected, const std::string& name) {
   if (actual != expected)
@@ -69,9 +66,9 @@ void SpringNetwork::validate() const {
     const std::string item = "node " + std::to_string(i);
     if (!rest_positions.row(i).allFinite()) fail(item, "rest position is not finite");
     if (!(masses[i] > 0.0) || !std::isfinite(masses[i]))
-      fail(item, "mass " + num(masses[i]) + " must be finite and > 0");
+      fail(item, "mass " + number_text(masses[i]) + " must be finite and > 0");
     if (!(node_damping[i] >= 0.0) || !std::isfinite(node_damping[i]))
-      fail(item, "damping " + num(node_damping[i]) + " must be finite and >= 0");
+      fail(item, "damping " + number_text(node_damping[i]) + " must be finite and >= 0");
     if (node_group[i] < 0 || node_group[i] >= static_cast<int>(node_group_names.size()))
       fail(item, "node group " + std::to_string(node_group[i]) + " out of range");
   }
@@ -82,12 +79,12 @@ void SpringNetwork::validate() const {
     if (springs(k, 0) == springs(k, 1))
       fail(item, "connects node " + std::to_string(springs(k, 0)) + " to itself");
     if (!(stiffness[k] >= 0.0) || !std::isfinite(stiffness[k]))
-      fail(item, "stiffness " + num(stiffness[k]) + " must be finite and >= 0");
+      fail(item, "stiffness " + number_text(stiffness[k]) + " must be finite and >= 0");
     if (!(damping[k] >= 0.0) || !std::isfinite(damping[k]))
-      fail(item, "damping " + num(damping[k]) + " must be finite and >= 0");
+      fail(item, "damping " + number_text(damping[k]) + " must be finite and >= 0");
     if (!(rest_length[k] > 0.0) || !std::isfinite(rest_length[k]))
-      fail(item,
-           "rest length " + num(rest_length[k]) + " must be finite and > 0 (zero-length spring)");
+      fail(item, "rest length " + number_text(rest_length[k]) +
+                     " must be finite and > 0 (zero-length spring)");
     const double current =
         (rest_positions.row(springs(k, 1)) - rest_positions.row(springs(k, 0))).norm();
     if (!(current > 0.0))
@@ -101,9 +98,9 @@ void SpringNetwork::validate() const {
     check_node(anchor_node[k], n, item);
     if (!anchor_point.row(k).allFinite()) fail(item, "anchor point is not finite");
     if (!(anchor_stiffness[k] >= 0.0) || !std::isfinite(anchor_stiffness[k]))
-      fail(item, "stiffness " + num(anchor_stiffness[k]) + " must be finite and >= 0");
+      fail(item, "stiffness " + number_text(anchor_stiffness[k]) + " must be finite and >= 0");
     if (!(anchor_damping[k] >= 0.0) || !std::isfinite(anchor_damping[k]))
-      fail(item, "damping " + num(anchor_damping[k]) + " must be finite and >= 0");
+      fail(item, "damping " + number_text(anchor_damping[k]) + " must be finite and >= 0");
   }
   for (int node : surface_nodes)
     check_node(node, n, "surface node list");
