@@ -35,10 +35,11 @@ double positive_option(const Options& opt, const std::string& key, double fallba
 // --seconds, else the path's own length, in ticks the trace can hold.
 double seconds_to_replay(const Options& opt, const ToolPath& path, double rate_hz) {
   const double seconds = positive_option(opt, "seconds", path.end() - path.start(), 3600.0);
-  const std::string what = opt.value("seconds")
-                               ? "--seconds " + *opt.value("seconds")
-                               : "--path " + *opt.value("path") + ": the path's length " +
-                                     std::to_string(seconds) + " s";
+  const auto path_file = opt.value("path");
+  const std::string path_name = path_file ? "--path " + *path_file : "the default tool path";
+  const std::string what =
+      opt.value("seconds") ? "--seconds " + *opt.value("seconds")
+                           : path_name + ": the path's length " + std::to_string(seconds) + " s";
   if (!opt.value("seconds") && seconds > 3600.0)
     throw cases::InputError(what + " is over an hour (are its times in seconds?); give --seconds");
   if (seconds * rate_hz > max_ticks)
