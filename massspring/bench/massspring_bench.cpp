@@ -5,8 +5,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <map>
 #include <memory>
+#include <stdexcept>
 
 #include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
@@ -40,11 +42,13 @@ const MassSpringModel& model_for(const std::string& name, bool volume = false) {
   static std::map<std::pair<std::string, bool>, std::unique_ptr<MassSpringModel>> models;
   auto& model = models[{name, volume}];
   if (!model) {
-    for (BenchmarkCase c : all_cases())
-      if (c.name == name) {
-        c.volume_preservation = c.volume_preservation || volume;
-        model = benchmark_model(c);
-      }
+    const auto& cases = all_cases();
+    const auto named = std::find_if(cases.begin(), cases.end(),
+                                    [&](const BenchmarkCase& c) { return c.name == name; });
+    if (named == cases.end()) throw std::out_of_range("no benchmark case named " + name);
+    BenchmarkCase c = *named;
+    c.volume_preservation = c.volume_preservation || volume;
+    model = benchmark_model(c);
   }
   return *model;
 }
