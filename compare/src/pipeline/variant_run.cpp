@@ -11,6 +11,7 @@
 #include "msfem/cases/errors.hpp"
 #include "msfem/cases/setting_names.hpp"
 #include "msfem/cases/surface_simplification.hpp"
+#include "msfem/compare/pipeline/progress.hpp"
 #include "msfem/fem_reference/supports_and_loads.hpp"
 #include "msfem/massspring/errors.hpp"
 #include "msfem/massspring/integrators.hpp"
@@ -29,7 +30,6 @@ namespace msfem::compare {
 namespace {
 
 namespace ms = msfem::massspring;
-using Clock = std::chrono::steady_clock;
 
 ms::SpringNetwork build_network(cases::Variant variant, const Problem& problem,
                                 const fem_reference::VolumeMesh& mesh) {
