@@ -135,6 +135,21 @@ MSFEM_LANE_CLONES void group_gradient(const VolumeBatches& b, int group, const d
     volume[l] = v[l] / 6.0;
 }
 
+MSFEM_LANE_CLONES void group_dot(const VolumeBatches& b, int group, const double* g,
+                                 const double* x, double* out) {
+  const int nodes = b.nodes(group);
+  const int* offset = b.offset.data() + b.group_start[group];
+  alignas(64) double sum[L] = {};
+  for (int k = 0; k < nodes; ++k) {
+    const int* at = offset + k * L;
+    const double* gk = g + 3 * k * L;
+    for (int l = 0; l < L; ++l)
+      sum[l] += gk[l] * x[at[l]] + gk[L + l] * x[at[l] + 1] + gk[2 * L + l] * x[at[l] + 2];
+  }
+  for (int l = 0; l < L; ++l)
+    out[l] = sum[l];
+}
+
 void scatter_group(const VolumeBatches& b, int group, const double* g, const double* s, double* f) {
   const int nodes = b.nodes(group), lanes = b.group_lanes[group];
   const int* offset = b.offset.data() + b.group_start[group];

@@ -51,6 +51,9 @@ VolumeBatches batch_elements(const std::vector<int>& element_start,
 /// The lanes' volumes V and g = −6 ∂V/∂x at their nodes (g[(3k + c)·L + l]), from positions x.
 void group_gradient(const VolumeBatches& b, int group, const double* x, double* g, double* volume);
 
+/// out[l] = Σ_k g_k(l) · x[node k of lane l] on every lane (group_gradient's g layout).
+void group_dot(const VolumeBatches& b, int group, const double* g, const double* x, double* out);
+
 /// f[node k of lane l] += s[l] g_k(l) for the group's filled lanes.
 void scatter_group(const VolumeBatches& b, int group, const double* g, const double* s, double* f);
 

@@ -34,20 +34,6 @@ void add_element_product(const Vec3* g, const int* offset, int nodes, double sca
     Vec3::Map(df + offset[k]) -= (scale * g_dx / 36.0) * g[k];
 }
 
-// ... two of them on one read of g, df1 += K dx1 and df2 += K dx2 ...
-void add_element_product_pair(const Vec3* g, const int* offset, int nodes, double scale,
-                              const double* dx1, double* df1, const double* dx2, double* df2) {
-  double g_dx1 = 0.0, g_dx2 = 0.0;
-  for (int k = 0; k < nodes; ++k) {
-    g_dx1 += g[k].dot(Vec3::Map(dx1 + offset[k]));
-    g_dx2 += g[k].dot(Vec3::Map(dx2 + offset[k]));
-  }
-  for (int k = 0; k < nodes; ++k) {
-    Vec3::Map(df1 + offset[k]) -= (scale * g_dx1 / 36.0) * g[k];
-    Vec3::Map(df2 + offset[k]) -= (scale * g_dx2 / 36.0) * g[k];
-  }
-}
-
 // ... and its diagonal blocks, times cx: blocks[i] −= cx scale/36 g_i g_iᵀ, the symmetric outer
 // product written out.
 void add_element_blocks(const Vec3* g, const int* offset, int nodes, double cx, double scale,
@@ -316,118 +302,6 @@ void VolumeForceField::add_dfdx_product_part(const Eigen::VectorXd& x, const Eig
                         element_node_start_[e + 1] - element_node_start_[e], scale, dx.data(),
                         df.data());
   }
-}
-
-// The definite Jacobian with each element's g = −6 ∂V taken at set_part and kept, so that a
-// product is the element's gather and scatter alone.
-class DefiniteVolumeTangent final : public ForceField::Tangent {
- public:
-  DefiniteVolumeTangent(const VolumeForceField& field, const Eigen::VectorXd& x)
-      : field_(&field),
-        x_(&x),
-        g_(field.element_node_offset_.size()),
-        scale_(static_cast<std::size_t>(field.elements_.num_elements()), 0.0),
-        volume_(scale_.size(), 0.0) {}
-
-  // The gradients in the field's lane groups (volume_batches.hpp), kept per element: a product
-  // then reads an element's gradient as one contiguous run beside its node offsets.
-  void set_part(int part, int parts) override {
-    const auto& f = *field_;
-    const detail::VolumeBatches& b = *f.batches_;
-    constexpr int L = detail::kVolumeLanes;
-    alignas(64) double g[3 * detail::kMaxShapeNodes * L];
-    double volume[L];
-    const auto [first, last] = b.group_range(part, parts);
-    for (int group = first; group < last; ++group) {
-      detail::group_gradient(b, group, x_->data(), g, volume);
-      for (int l = 0; l < b.group_lanes[group]; ++l) {
-        const int e = b.element[static_cast<std::size_t>(group * L + l)];
-        scale_[static_cast<std::size_t>(e)] =
-            f.elements_.modulus[e] / std::abs(f.elements_.rest_volume[e]);
-        volume_[static_cast<std::size_t>(e)] = volume[l];
-        Vec3* kept = g_.data() + f.element_node_start_[e];
-        for (int k = 0; k < nodes(e); ++k)
-          kept[k] = Vec3(g[3 * k * L + l], g[(3 * k + 1) * L + l], g[(3 * k + 2) * L + l]);
-      }
-    }
-  }
-
-  void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
-                        int parts) const override {
-    for_each_element(part, parts, [&](int e) {
-      if (scale_[static_cast<std::size_t>(e)] != 0.0)
-        add_element_product(gradient(e), offsets(e), nodes(e), scale_[static_cast<std::size_t>(e)],
-                            dx.data(), df.data());
-    });
-  }
-
-  void add_product_pair_part(const Eigen::VectorXd& dx1, Eigen::VectorXd& df1,
-                             const Eigen::VectorXd& dx2, Eigen::VectorXd& df2, int part,
-                             int parts) const override {
-    for_each_element(part, parts, [&](int e) {
-      if (scale_[static_cast<std::size_t>(e)] != 0.0)
-        add_element_product_pair(gradient(e), offsets(e), nodes(e),
-                                 scale_[static_cast<std::size_t>(e)], dx1.data(), df1.data(),
-                                 dx2.data(), df2.data());
-    });
-  }
-
-  // The force −κ (V − V⁰)/|V⁰| ∂V = scale (V − V⁰) g / 6 from the gradient and volume set_part
-  // kept: the explicit pass's work without its second read of x.
-  bool add_force_part(Eigen::VectorXd& f, int part, int parts) const override {
-    for_each_element(part, parts, [&](int e) {
-      const double pressure =
-          scale_[static_cast<std::size_t>(e)] *
-          (volume_[static_cast<std::size_t>(e)] - field_->elements_.rest_volume[e]);
-      if (pressure == 0.0) return;
-      const Vec3* g = gradient(e);
-      const int* offset = offsets(e);
-      for (int k = 0; k < nodes(e); ++k)
-        Vec3::Map(f.data() + offset[k]) += (pressure / 6.0) * g[k];
-    });
-    return true;
-  }
-
-  // The field has no velocity term: cv does not enter.
-  void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
-                                int parts) const override {
-    for_each_element(part, parts, [&](int e) {
-      add_element_blocks(gradient(e), offsets(e), nodes(e), cx, scale_[static_cast<std::size_t>(e)],
-                         blocks);
-    });
-  }
-
- private:
-  // The elements of part `part` of `parts` of the lane groups: set_part's, so that a thread reads
-  // only the gradients it wrote itself.
-  template <class Visit>
-  void for_each_element(int part, int parts, const Visit& visit) const {
-    const detail::VolumeBatches& b = *field_->batches_;
-    const auto [first, last] = b.group_range(part, parts);
-    for (int group = first; group < last; ++group)
-      for (int l = 0; l < b.group_lanes[group]; ++l)
-        visit(b.element[static_cast<std::size_t>(group * detail::kVolumeLanes + l)]);
-  }
-  int nodes(int e) const {
-    return field_->element_node_start_[e + 1] - field_->element_node_start_[e];
-  }
-  const int* offsets(int e) const {
-    return field_->element_node_offset_.data() + field_->element_node_start_[e];
-  }
-  const Vec3* gradient(int e) const { return g_.data() + field_->element_node_start_[e]; }
-
-  const VolumeForceField* field_;
-  const Eigen::VectorXd* x_;
-  std::vector<Vec3> g_;         // per element node, as element_node_offset_
-  std::vector<double> scale_;   // per element, κ/|V⁰|
-  std::vector<double> volume_;  // per element, V at set_part
-};
-
-std::unique_ptr<ForceField::Tangent> VolumeForceField::tangent(const Eigen::VectorXd& x,
-                                                               const Eigen::VectorXd& v,
-                                                               Linearisation mode) const {
-  if (mode == Linearisation::exact) return ForceField::tangent(x, v, mode);
-  return std::make_unique<DefiniteVolumeTangent>(*this, x);
 }
 
 // The blocks of −(κ/|V⁰|) ∂V ∂Vᵀ: the exact Jacobian's diagonal blocks are these too, as an

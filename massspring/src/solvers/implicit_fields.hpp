@@ -60,6 +60,12 @@ class ImplicitFields {
       }
       nodes_.push_back({node, id, lane, block});
     }
+    // By block, the constrained nodes first (member 0's): a member's nodes are then one range.
+    std::stable_sort(nodes_.begin(), nodes_.end(),
+                     [](const Node& p, const Node& q) { return p.block < q.block; });
+    node_offsets_.clear();
+    for (int node = 0; node < soa_->num_nodes; ++node)
+      if (used[static_cast<std::size_t>(node)]) node_offsets_.push_back(3 * node);
     const Eigen::Index dofs = 3 * static_cast<Eigen::Index>(soa_->num_nodes);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(fields_.empty() ? 0 : dofs);
     for (auto* v : {&x_, &v_, &hv_, &dv_, &hdv_, &hu_, &u_})
@@ -75,8 +81,7 @@ class ImplicitFields {
 
   // Before the linearising pass: x, v and the warm start Δv at this member's field nodes.
   void gather_state(int b0, int b1, const Real* records, const Real* dv_records, double h) {
-    for (const Node& n : nodes_) {
-      if (!owns(n, b0, b1)) continue;
+    for (const Node& n : owned(b0, b1)) {
       for (int c = 0; c < 3; ++c) {
         const Eigen::Index k = 3 * n.node + c;
         x_[k] = records[kRecord * n.id + c];
@@ -90,15 +95,12 @@ class ImplicitFields {
 
   // After the pass's barrier, this member's part of the fields' right-hand side, b_F / h =
   // f_F + K_F (h v), of -A_F Δv / h = K_F (h Δv) + D_F Δv and of the diagonal blocks of
-  // -A_F = h D_F + h² K_F.
+  // -A_F = h D_F + h² K_F. The parts are zero at every field node here: start_apply clears
+  // what it reads.
   void start_part(int member, int members, double h) {
     Eigen::VectorXd& b = b_part_[static_cast<std::size_t>(member)];
     Eigen::VectorXd& a = a_part_[static_cast<std::size_t>(member)];
     std::vector<Eigen::Matrix3d>& blocks = blocks_part_[static_cast<std::size_t>(member)];
-    zero_at_nodes(b);
-    zero_at_nodes(a);
-    for (const Node& n : nodes_)
-      blocks[static_cast<std::size_t>(n.node)].setZero();
     for (std::size_t k = 0; k < fields_.size(); ++k) {
       tangents_[k]->set_part(member, members);
       if (!tangents_[k]->add_force_part(b, member, members))
@@ -110,18 +112,26 @@ class ImplicitFields {
   }
 
   // After the next barrier, at this member's field lanes: b += b_F, r += b_F - A_F Δv, the
-  // preconditioner's block B += A_F (re-inverted), u = B⁻¹ r into cg.p and `u_records`.
+  // preconditioner's block B += A_F (re-inverted), u = B⁻¹ r into cg.p and `u_records`. Clears
+  // the parts it reads at this member's nodes, so that no member zeroes a whole part each step.
   void start_apply(int b0, int b1, int members, const CgVectors<Real>& cg, Real* u_records,
                    double h) {
-    for (const Node& n : nodes_) {
-      if (n.lane < 0 || !owns(n, b0, b1)) continue;
+    for (const Node& n : owned(b0, b1)) {
       Eigen::Vector3d b_field = Eigen::Vector3d::Zero(), a_field = Eigen::Vector3d::Zero();
       Eigen::Matrix3d field_block = Eigen::Matrix3d::Zero();
       for (int m = 0; m < members; ++m) {
-        b_field += b_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
-        a_field += a_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
-        field_block += blocks_part_[static_cast<std::size_t>(m)][static_cast<std::size_t>(n.node)];
+        auto b_part = b_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
+        auto a_part = a_part_[static_cast<std::size_t>(m)].template segment<3>(3 * n.node);
+        Eigen::Matrix3d& block =
+            blocks_part_[static_cast<std::size_t>(m)][static_cast<std::size_t>(n.node)];
+        b_field += b_part;
+        a_field += a_part;
+        field_block += block;
+        b_part.setZero();
+        a_part.setZero();
+        block.setZero();
       }
+      if (n.lane < 0) continue;
       Eigen::Vector3d r;
       for (int c = 0; c < 3; ++c) {
         cg.b[c][n.lane] += static_cast<Real>(h * b_field[c]);
@@ -142,8 +152,7 @@ class ImplicitFields {
   // Before a product: h u at this member's field nodes (u of every node is complete in
   // `u_records` since the last reduction).
   void gather_direction(int b0, int b1, const Real* u_records, double h) {
-    for (const Node& n : nodes_) {
-      if (!owns(n, b0, b1)) continue;
+    for (const Node& n : owned(b0, b1)) {
       for (int c = 0; c < 3; ++c) {
         u_[3 * n.node + c] = u_records[kDirection * n.id + c];
         hu_[3 * n.node + c] = h * u_[3 * n.node + c];
@@ -152,30 +161,32 @@ class ImplicitFields {
   }
 
   // After the product's barrier: this member's part of -A_F u / h = K_F (h u) + D_F u, and its
-  // part of u·(-A_F u)/h.
+  // part of u·(-A_F u)/h. The part is zero at every field node here: product_apply clears it.
   void product_part(int member, int members) {
     Eigen::VectorXd& y = product_part_[static_cast<std::size_t>(member)];
-    zero_at_nodes(y);
     for (std::size_t k = 0; k < fields_.size(); ++k) {
       tangents_[k]->add_product_part(hu_, y, member, members);
       if (member == 0) fields_[k]->add_dfdv_product(x_, u_, y);
     }
     double dot = 0.0;
-    for (const Node& n : nodes_)
-      dot += u_.template segment<3>(3 * n.node).dot(y.template segment<3>(3 * n.node));
+    for (int offset : node_offsets_)
+      dot +=
+          u_[offset] * y[offset] + u_[offset + 1] * y[offset + 1] + u_[offset + 2] * y[offset + 2];
     member_dots_[static_cast<std::size_t>(member)] = dot;
   }
 
-  // After the next barrier: w += A_F u at this member's field lanes; returns u·A_F u (every
-  // member the same sum).
-  double product_apply(int b0, int b1, int members, const CgVectors<Real>& cg, double h) const {
-    for (const Node& n : nodes_) {
-      if (n.lane < 0 || !owns(n, b0, b1)) continue;
+  // After the next barrier: w += A_F u at this member's field lanes, the parts cleared at its
+  // nodes; returns u·A_F u (every member the same sum).
+  double product_apply(int b0, int b1, int members, const CgVectors<Real>& cg, double h) {
+    for (const Node& n : owned(b0, b1)) {
       for (int c = 0; c < 3; ++c) {
         double sum = 0.0;
-        for (int m = 0; m < members; ++m)
-          sum += product_part_[static_cast<std::size_t>(m)][3 * n.node + c];
-        cg.y[c][n.lane] -= static_cast<Real>(h * sum);
+        for (int m = 0; m < members; ++m) {
+          double& part = product_part_[static_cast<std::size_t>(m)][3 * n.node + c];
+          sum += part;
+          part = 0.0;
+        }
+        if (n.lane >= 0) cg.y[c][n.lane] -= static_cast<Real>(h * sum);
       }
     }
     double dot = 0.0;
@@ -189,12 +200,20 @@ class ImplicitFields {
     int node, id, lane, block;  // original id, layout id, lane (-1: constrained), block
   };
 
-  static bool owns(const Node& n, int b0, int b1) {
-    return n.block < 0 ? b0 == 0 : n.block >= b0 && n.block < b1;
-  }
-  void zero_at_nodes(Eigen::VectorXd& vector) const {
-    for (const Node& n : nodes_)
-      vector.template segment<3>(3 * n.node).setZero();
+  struct NodeRange {
+    const Node *first, *last;
+    const Node* begin() const { return first; }
+    const Node* end() const { return last; }
+  };
+  // The field nodes of the member that handles blocks [b0, b1): those whose lanes lie in them,
+  // and for the member of block 0 the constrained ones.
+  NodeRange owned(int b0, int b1) const {
+    const auto from = [&](int block) {
+      return std::partition_point(nodes_.begin(), nodes_.end(),
+                                  [&](const Node& n) { return n.block < block; });
+    };
+    const auto first = b0 == 0 ? nodes_.begin() : from(b0);
+    return {nodes_.data() + (first - nodes_.begin()), nodes_.data() + (from(b1) - nodes_.begin())};
   }
   static Eigen::Matrix3d read_block(const CgVectors<Real>& cg, int lane) {
     const auto q = [&](int e) { return static_cast<double>(cg.inverse_block[e][lane]); };
@@ -213,7 +232,8 @@ class ImplicitFields {
   int team_;
   std::vector<std::shared_ptr<const ForceField>> fields_;
   std::vector<std::unique_ptr<ForceField::Tangent>> tangents_;  // one per field, set each step
-  std::vector<Node> nodes_;
+  std::vector<Node> nodes_;                         // by block, the constrained (block -1) first
+  std::vector<int> node_offsets_;                   // 3·node of the field nodes, ascending
   Eigen::VectorXd x_, v_, hv_, dv_, hdv_, hu_, u_;  // shared, written at field nodes by owners
   std::vector<Eigen::VectorXd> b_part_, a_part_, product_part_;  // per member
   // per member, per node: its part of h D_F + h² K_F
