@@ -42,5 +42,31 @@ TEST(TimingWork, TheSweepAndTheBenchStepTheSameSeedSphere) {
   }
 }
 
+// The settle time of msfem run: the seed sphere's three tiers sag under gravity to within 1 % of
+// their static equilibrium; against an equilibrium no run can approach (the same, every node
+// lifted 1 cm) the run ends unsettled long before its 20 s wall limit, saying how far it stayed.
+TEST(TimingWork, SettlingEndsAtTheEquilibriumOrOnceTheRunStopsApproachingIt) {
+  const cases::CaseParameters parameters =
+      cases::read_case(std::string(MSFEM_CASES_DIR) + "/sphere_indent.prm",
+                       {"loads/tool/enabled=false", "loads/gravity=0,0,-9.81"});
+  const Problem problem = make_problem(parameters);
+  const BuiltVariant variant =
+      build_variant(cases::Variant::single_layer, problem, {}, std::nullopt);
+  const StaticSolution equilibrium = solve_variant_static(variant, Eigen::VectorXd());
+
+  const Timing reached = time_variant(variant, parameters.timing, equilibrium.x);
+  EXPECT_TRUE(reached.settled);
+  EXPECT_LE(reached.settle_distance, 0.01);
+  EXPECT_GT(reached.settle_time_s, 0.0);
+
+  Eigen::VectorXd unreachable = equilibrium.x;
+  for (Eigen::Index i = 2; i < unreachable.size(); i += 3)
+    unreachable[i] += 0.01;
+  const Timing stalled = time_variant(variant, parameters.timing, unreachable);
+  EXPECT_FALSE(stalled.settled);
+  EXPECT_GT(stalled.settle_distance, 0.9);
+  EXPECT_LT(stalled.settle_time_s, 10.0);
+}
+
 }  // namespace
 }  // namespace msfem::compare

@@ -50,7 +50,8 @@ template <typename Io, typename T>
 void timing_fields(Io& io, T& t) {
   io.io(t.integrator), io.io(t.stepper), io.io(t.dt_s), io.io(t.steps_per_second);
   io.io(t.stable_dt_s), io.io(t.predicted_stable_dt_s), io.io(t.realtime_factor);
-  io.io(t.settle_time_s), io.io(t.settled), io.io(t.ms_per_60hz_frame);
+  io.io(t.settle_time_s), io.io(t.settled), io.io(t.settle_distance);
+  io.io(t.ms_per_60hz_frame);
 }
 
 template <typename Io, typename P>

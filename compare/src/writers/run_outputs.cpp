@@ -279,10 +279,12 @@ std::string report_markdown(const CaseRun& run, const Plots& plots) {
         "| "
         "settle time s |\n|---|---|---|---|---|---|\n";
   for (const auto& v : run.variants) {
-    char row[256], settle[64] = "-";
-    if (!v.timing.integrator.empty())
-      std::snprintf(settle, sizeof settle, "%.3f%s", v.timing.settle_time_s,
-                    v.timing.settled ? "" : " (not settled)");
+    char row[320], settle[96] = "-";
+    if (!v.timing.integrator.empty() && v.timing.settled)
+      std::snprintf(settle, sizeof settle, "%.3f", v.timing.settle_time_s);
+    else if (!v.timing.integrator.empty())
+      std::snprintf(settle, sizeof settle, "%.3f (not settled: %.3g× the travel away)",
+                    v.timing.settle_time_s, v.timing.settle_distance);
     const ToolLoadVariant& own = v.loads.front();
     std::snprintf(row, sizeof row, "| %s | %.4f | %.4f | %.4f | %.2e | %s |\n", v.name.c_str(),
                   own.displacement.contact_zone.rel_l2_error,

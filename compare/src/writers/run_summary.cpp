@@ -268,6 +268,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"realtime_factor", v.timing.realtime_factor},
       {"settle_time_s", v.timing.settle_time_s},
       {"settled", v.timing.settled},
+      {"settle_distance_over_travel", v.timing.settle_distance},
       {"ms_per_60hz_frame", v.timing.ms_per_60hz_frame},
       {"newton_iterations", first.newton_iterations},
       {"force_depth", fd},

@@ -121,6 +121,9 @@ struct Timing {
   double realtime_factor = 0.0;  ///< stable dt × steps/s (simulated s per wall s)
   double settle_time_s = 0.0;    ///< wall time to within 1 % of equilibrium after the load
   bool settled = false;
+  /// distance from the static equilibrium where settling ended, over the load's travel (below
+  /// 0.01 when settled; far above 1 for a model that came to rest in another equilibrium)
+  double settle_distance = 0.0;
   double ms_per_60hz_frame = 0.0;
 };
 /// Times the case's integrator on the variant (with its loads), starting from rest, against the
