@@ -39,9 +39,16 @@ void warn_if_not_organ_sized(const cases::CaseParameters& p, const cases::Surfac
 }
 
 // The organ of a NIfTI image, as extracted; the case's own simplification and smoothing follow.
-cases::Surface surface_of_image(const std::string& source, std::vector<std::string>& notes) {
+// The extraction's refusals name the image; the case file and key are put before them.
+cases::Surface surface_of_image(const cases::CaseParameters& p, std::vector<std::string>& notes) {
+  const std::string& source = p.geometry.source;
   const cases::ImageSource image = cases::parse_image_source(source);
-  cases::ImageSurface extracted = cases::surface_from_image(image.file, {image.selection, 0, 0});
+  cases::ImageSurface extracted;
+  try {
+    extracted = cases::surface_from_image(image.file, {image.selection, 0, 0});
+  } catch (const cases::InputError& e) {
+    throw cases::InputError(p.file.string() + ": geometry/source = " + source + ": " + e.what());
+  }
   for (const auto& note : extracted.notes)
     notes.push_back(note);
   notes.push_back("extracted " + std::to_string(extracted.surface.num_vertices()) +
@@ -385,7 +392,7 @@ cases::Surface source_surface(const cases::CaseParameters& p, std::vector<std::s
   if (cases::is_network_source(g.source))
     return cases::network_surface(cases::network_source_file(g.source));
   return cases::is_surface_generator(g.source) ? cases::generate_surface(g.source)
-         : cases::is_image_source(g.source)    ? surface_of_image(g.source, notes)
+         : cases::is_image_source(g.source)    ? surface_of_image(p, notes)
                                                : cases::read_surface(g.source, g.unit);
 }
 
