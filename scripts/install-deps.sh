@@ -10,6 +10,7 @@ packages=(
   libdeal.ii-dev         # FEM reference; brings PETSc (hypre, MUMPS), MPI, HDF5, Gmsh, CGAL, p4est
   libcgal-dev            # surface validation (self-intersections), simplification, Mesh_3 extraction
   libnifti2-dev          # msfem surface-from-image: NIfTI-1/2 reader (niftilib, the reference implementation)
+  openmpi-bin            # mpirun: the quick start's two ranks, msfem under MPI (docs/scale-out.md)
   libhdf5-openmpi-dev    # fields.h5 output (the HDF5 deal.II links, so one HDF5 per process)
   nlohmann-json3-dev     # summary.json and every --json output
   libpugixml-dev         # user networks as VTK XML (.vtu): a small DOM reader; zlib (deal.II's) inflates
