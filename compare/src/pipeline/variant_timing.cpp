@@ -51,8 +51,8 @@ double median_rate(ms::Stepper& stepper, double dt, int steps) {
 // largest distance over a simulated second (the envelope of a ringing approach: a swing can pass
 // close early on) has not come 1 % of the travel below its best for two seconds running. A model
 // can come to rest in another equilibrium: three_tier on the default sphere snaps through under a
-// tool applied at once and rests six times its travel away, which the wall limit alone let run
-// for 20 s on every case run.
+// tool applied at once and rests six to eight times its travel away; with the wall limit alone
+// it would run 20 s on every case run.
 void settle(Timing& t, ms::Stepper& stepper, const BuiltVariant& variant,
             const Eigen::VectorXd& x_rest, const Eigen::VectorXd& equilibrium) {
   const double travel = (equilibrium - x_rest).norm();
