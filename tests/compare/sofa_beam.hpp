@@ -191,7 +191,9 @@ inline void write_sofa_beam_case(const std::filesystem::path& file, const std::s
                          "subsection loads\n  set gravity = 0, 0, -9.81\n"
                          "  subsection tool\n    set enabled = false\n  end\nend\n"
                          "subsection mass spring\n  set variants =\n  set networks = "
-                      << networks << "\nend\nsubsection fem\n  set degree = 1\nend\n";
+                      << networks
+                      << "\nend\nsubsection fem\n  set degree = 1\n"
+                         "  set error estimate = none\nend\n";
 }
 
 }  // namespace msfem::testing

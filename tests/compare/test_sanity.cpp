@@ -43,7 +43,8 @@ TEST(Sanity, TetEdgesIsCloserThanSingleLayerAtNuQuarterOnEverySweepResolution) {
   TemporaryDirectory dir;
   const auto r = run_msfem("sweep " + cases_dir +
                            "/sphere_indent_nu025.prm --quiet --resolutions 2,3,4 "
-                           "--integrators symplectic_euler --set timing/steps=200 --out " +
+                           "--integrators symplectic_euler --set timing/steps=200 "
+                           "--set 'fem/error estimate=none' --out " +
                            (dir / "sweep").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(read_text(dir / "sweep" / "sweep.json"));
@@ -68,7 +69,8 @@ TEST(Sanity, VolumePreservationBringsTheNetworksCloserAtNuPointFourFive) {
   for (const std::string setting : {"false", "true"}) {
     const auto out = dir / ("run-" + setting);
     const auto r = run_msfem("run " + cases_dir +
-                             "/sphere_indent_bonded.prm --quiet --set timing/steps=100 --set "
+                             "/sphere_indent_bonded.prm --quiet --set timing/steps=100 "
+                             "--set 'fem/error estimate=none' --set "
                              "'mass spring/variants=tet_edges,three_tier' --set 'mass "
                              "spring/volume preservation=" +
                              setting + "' --out " + out.string());
@@ -103,7 +105,8 @@ class ForceDepth : public ::testing::TestWithParam<const char*> {};
 TEST_P(ForceDepth, FemAndEveryVariantPushBackHarderTheDeeperTheTool) {
   TemporaryDirectory dir;
   const auto r = run_msfem("run " + cases_dir + "/" + GetParam() +
-                           ".prm --quiet --no-timing --out " + (dir / "run").string());
+                           ".prm --quiet --no-timing --set 'fem/error estimate=none' --out " +
+                           (dir / "run").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(read_text(dir / "run" / "summary.json"));
   const auto& normal = j["tools"][0]["outward_normal"];

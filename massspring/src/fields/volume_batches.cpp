@@ -26,13 +26,15 @@ std::pair<int, int> VolumeBatches::group_range(int part, int parts) const {
 VolumeBatches batch_elements(const std::vector<int>& element_start,
                              const std::vector<int>& element_offset,
                              const std::vector<std::array<std::uint8_t, 4>>& local_tets,
-                             const std::vector<int>& tet_start, const double* tet_weight) {
+                             const std::vector<int>& tet_start, const double* tet_weight,
+                             const std::vector<int>* order) {
   VolumeBatches b;
   const int elements = static_cast<int>(tet_start.size()) - 1;
   using Key = std::tuple<int, std::vector<std::array<std::uint8_t, 4>>, std::vector<double>>;
   std::map<Key, int> shape_of;
   std::vector<std::vector<int>> members;
-  for (int e = 0; e < elements; ++e) {
+  for (int i = 0; i < elements; ++i) {
+    const int e = order ? (*order)[static_cast<std::size_t>(i)] : i;
     VolumeShape shape;
     shape.nodes = element_start[e + 1] - element_start[e];
     for (int t = tet_start[e]; t < tet_start[e + 1]; ++t) {

@@ -40,13 +40,14 @@ struct VolumeBatches {
 };
 
 /// Groups the elements by shape, in element order within a shape (elements built in surface
-/// order keep their neighbours close). `element_start` / `element_offset`: each element's distinct
-/// nodes as 3·id; `local_tets`: each tetrahedron's corners as indices into them; `tet_start`,
-/// `tet_weight`: the elements' tetrahedra.
+/// order keep their neighbours close), or in the order `order` lists them. `element_start` /
+/// `element_offset`: each element's distinct nodes as 3·id; `local_tets`: each tetrahedron's
+/// corners as indices into them; `tet_start`, `tet_weight`: the elements' tetrahedra.
 VolumeBatches batch_elements(const std::vector<int>& element_start,
                              const std::vector<int>& element_offset,
                              const std::vector<std::array<std::uint8_t, 4>>& local_tets,
-                             const std::vector<int>& tet_start, const double* tet_weight);
+                             const std::vector<int>& tet_start, const double* tet_weight,
+                             const std::vector<int>* order = nullptr);
 
 /// The lanes' volumes V and g = −6 ∂V/∂x at their nodes (g[(3k + c)·L + l]), from positions x.
 void group_gradient(const VolumeBatches& b, int group, const double* x, double* g, double* volume);

@@ -64,10 +64,10 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       inverse_block_[e].assign(lanes, Real(0));
       cg_.inverse_block[e] = inverse_block_[e].data();
     }
-    take_fields(model);
     // Equal shares of the layout's blocks of chunks (about equal slot counts).
     for (int m = 0; m <= team_.size(); ++m)
       member_block_.push_back(static_cast<int>(static_cast<long>(blocks()) * m / team_.size()));
+    take_fields(model);
     for (auto& sums : block_sums_)
       sums.assign(3 * static_cast<std::size_t>(blocks()), 0.0);
     pack();
@@ -117,7 +117,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       auto reduced = [&](auto kernel, double(&values)[3]) {
         for (int block = b0; block < b1; ++block) {
           double* sums = &block_sums_[parity][3 * block];
-          kernel(gather_.block_begin[block], gather_.block_begin[block + 1], sums);
+          kernel(block, sums);
         }
         if (members > 1) team_.barrier();
         for (int k = 0; k < 3; ++k) {
@@ -133,10 +133,11 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       double sums[3];  // r·u, r·r, b·b; the barrier also completes the u records
       if (!fields_.empty()) fields_.gather_state(b0, b1, records_.data(), dv_records_.data(), h);
       reduced(
-          [&](int c0, int c1, double* out) {
+          [&](int block, double* out) {
             double local[3];
             kernels_.linearise_start(gather_, records_.data(), dv_records_.data(), system_, cg_,
-                                     p_records_.data(), c0, c1, h, local);
+                                     p_records_.data(), gather_.block_begin[block],
+                                     gather_.block_begin[block + 1], h, local);
             std::copy(local, local + 3, out);
           },
           sums);
@@ -144,21 +145,28 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         fields_.start_part(member, members, dt);
         if (members > 1) team_.barrier();
         fields_.start_apply(b0, b1, members, cg_, p_records_.data(), dt);
-        reduced([&](int c0, int c1, double* out) { start_sums(c0, c1, out); }, sums);
+        reduced([&](int block, double* out) { start_sums(block, out); }, sums);
       }
+      const int plan = fields_.member_plan(member, members);
       double gamma = sums[0], rr = sums[1], alpha = 0.0, previous_gamma = 0.0;
       const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
       int iteration = 0;
       while (iteration < options_.cg_max_iterations && rr > target) {
         double delta[3];  // u·A u
-        if (!fields_.empty()) fields_.gather_direction(b0, b1, p_records_.data(), dt);
+        if (fields_.rows())
+          fields_.rows_product(plan, p_records_.data(), dt);
+        else if (!fields_.empty())
+          fields_.gather_direction(b0, b1, p_records_.data(), dt);
         reduced(
-            [&](int c0, int c1, double* out) {
-              out[0] = kernels_.product(gather_, system_, p_records_.data(), cg_.p, cg_.y, c0, c1);
+            [&](int block, double* out) {
+              out[0] = kernels_.product(gather_, system_, p_records_.data(), cg_.p, cg_.y,
+                                        gather_.block_begin[block], gather_.block_begin[block + 1]);
+              if (fields_.rows())
+                out[0] += fields_.rows_apply(plan, block, cg_, p_records_.data(), dt);
               out[1] = out[2] = 0.0;
             },
             delta);
-        if (!fields_.empty()) {
+        if (!fields_.empty() && !fields_.rows()) {
           fields_.product_part(member, members);
           if (members > 1) team_.barrier();
           delta[0] += fields_.product_apply(b0, b1, members, cg_, dt);
@@ -170,11 +178,12 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         alpha = gamma / curvature;
         double next[3];  // r·u, r·r; the barrier also completes the u records
         reduced(
-            [&](int c0, int c1, double* out) {
+            [&](int block, double* out) {
               double local[3];
               kernels_.cg_iterate(gather_, cg_, direction_pointers_, direction_product_pointers_,
                                   p_records_.data(), static_cast<Real>(alpha),
-                                  static_cast<Real>(beta), c0, c1, local);
+                                  static_cast<Real>(beta), gather_.block_begin[block],
+                                  gather_.block_begin[block + 1], local);
               std::copy(local, local + 3, out);
             },
             next);
@@ -205,7 +214,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   // The fields and the right-hand side vector they add to (kept by the linearising pass only
   // then: it costs a model without fields a store per lane).
   void take_fields(const MechanicalSystem& model) {
-    fields_.take(model);
+    fields_.take(model, member_block_);
     const std::size_t lanes = gather_.lane_node.size();
     for (int c = 0; c < 3; ++c) {
       rhs_[c].assign(fields_.empty() ? 0 : lanes, Real(0));
@@ -213,11 +222,12 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     }
   }
 
-  // r·u, r·r and b·b over the lanes of chunks [c0, c1), once the fields have changed r and u.
-  void start_sums(int c0, int c1, double* out) const {
+  // r·u, r·r and b·b over the lanes of block `block`, once the fields have changed r and u.
+  void start_sums(int block, double* out) const {
     double sums[3] = {0.0, 0.0, 0.0};
-    for (std::size_t lane = static_cast<std::size_t>(c0) * W;
-         lane < static_cast<std::size_t>(c1) * W; ++lane)
+    const std::size_t begin = static_cast<std::size_t>(gather_.block_begin[block]) * W,
+                      end = static_cast<std::size_t>(gather_.block_begin[block + 1]) * W;
+    for (std::size_t lane = begin; lane < end; ++lane)
       for (int c = 0; c < 3; ++c) {
         const double r = cg_.r[c][lane], b = cg_.b[c][lane];
         sums[0] += r * cg_.p[c][lane];

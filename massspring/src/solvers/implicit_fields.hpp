@@ -27,9 +27,14 @@ class ImplicitFields {
       : soa_(&soa), gather_(&gather), team_(team) {}
 
   bool empty() const { return fields_.empty(); }
+  // Whether every field's tangent gives rows (ForceField::Tangent::plan_rows): the CG products
+  // then go through rows_product and rows_apply, with no parts to sum and no barrier of their own.
+  bool rows() const { return rows_; }
 
   // The model's fields and, per field node, its new id, lane and block (-1 when constrained).
-  void take(const MechanicalSystem& model) {
+  // `member_block`: the members' first blocks when the whole team steps, then the number of
+  // blocks.
+  void take(const MechanicalSystem& model, const std::vector<int>& member_block) {
     fields_.clear();
     tangents_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
@@ -77,7 +82,44 @@ class ImplicitFields {
                             fields_.empty() ? 0 : static_cast<std::size_t>(soa_->num_nodes),
                             Eigen::Matrix3d::Zero()));
     member_dots_.assign(static_cast<std::size_t>(team_), 0.0);
+    plan_rows(member_block, dofs);
   }
+
+  // Before a product, by the member with plan `plan` (member_plan): h u at every field node into
+  // its own vector (u of every node is complete in `u_records` since the last reduction), and the
+  // fields' rows -A_F u / h = K_F (h u) at its nodes.
+  void rows_product(int plan, const Real* u_records, double h) {
+    Eigen::VectorXd& hu = plan_u_[static_cast<std::size_t>(plan)];
+    Eigen::VectorXd& y = plan_y_[static_cast<std::size_t>(plan)];
+    for (const Node& n : nodes_)
+      for (int c = 0; c < 3; ++c)
+        hu[3 * n.node + c] = h * u_records[kDirection * n.id + c];
+    for (const Node& n : plan_nodes_[static_cast<std::size_t>(plan)])
+      y.template segment<3>(3 * n.node).setZero();
+    for (const auto& tangent : tangents_)
+      tangent->add_product_rows(hu, y, plan);
+  }
+
+  // Once the spring product has written w at block `block`'s lanes: w += A_F u at the plan's
+  // nodes there; returns their part of u·A_F u.
+  double rows_apply(int plan, int block, const CgVectors<Real>& cg, const Real* u_records,
+                    double h) const {
+    const Eigen::VectorXd& y = plan_y_[static_cast<std::size_t>(plan)];
+    const auto& nodes = plan_nodes_[static_cast<std::size_t>(plan)];
+    const std::size_t p = static_cast<std::size_t>(plan);
+    double dot = 0.0;
+    for (auto n = nodes.begin() + plan_block_start_[p][block];
+         n != nodes.begin() + plan_block_start_[p][block + 1]; ++n)
+      for (int c = 0; c < 3; ++c) {
+        const double yc = y[3 * n->node + c];
+        cg.y[c][n->lane] -= static_cast<Real>(h * yc);
+        dot += u_records[kDirection * n->id + c] * yc;
+      }
+    return -h * dot;
+  }
+
+  // The plan of member `member` of `members` (1, or the whole team).
+  int member_plan(int member, int members) const { return members == 1 ? team_ : member; }
 
   // Before the linearising pass: x, v and the warm start Δv at this member's field nodes.
   void gather_state(int b0, int b1, const Real* records, const Real* dv_records, double h) {
@@ -215,6 +257,38 @@ class ImplicitFields {
     const auto first = b0 == 0 ? nodes_.begin() : from(b0);
     return {nodes_.data() + (first - nodes_.begin()), nodes_.data() + (from(b1) - nodes_.begin())};
   }
+  // Plan m < team for member m of the whole team, plan `team` for one member stepping alone:
+  // the field nodes with lanes in the member's blocks.
+  void plan_rows(const std::vector<int>& member_block, Eigen::Index dofs) {
+    rows_ = !fields_.empty();
+    plan_nodes_.assign(static_cast<std::size_t>(team_) + 1, {});
+    std::vector<std::vector<int>> rows(static_cast<std::size_t>(team_) + 1);
+    for (int plan = 0; plan <= team_; ++plan) {
+      const int b0 = plan == team_ ? 0 : member_block[static_cast<std::size_t>(plan)];
+      const int b1 = plan == team_ ? member_block.back() : member_block[plan + 1];
+      for (const Node& n : owned(b0, b1))
+        if (n.lane >= 0) {
+          plan_nodes_[static_cast<std::size_t>(plan)].push_back(n);
+          rows[static_cast<std::size_t>(plan)].push_back(n.node);
+        }
+    }
+    for (const auto& tangent : tangents_)
+      rows_ = tangent->plan_rows(rows) && rows_;
+    // Per plan and block: where the block's nodes start in the plan's (nodes are by block).
+    plan_block_start_.assign(static_cast<std::size_t>(team_) + 1, {});
+    for (int plan = 0; plan <= team_; ++plan) {
+      const auto& nodes = plan_nodes_[static_cast<std::size_t>(plan)];
+      auto& start = plan_block_start_[static_cast<std::size_t>(plan)];
+      for (int block = 0; block <= member_block.back(); ++block)
+        start.push_back(
+            static_cast<int>(std::partition_point(nodes.begin(), nodes.end(),
+                                                  [&](const Node& n) { return n.block < block; }) -
+                             nodes.begin()));
+    }
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(rows_ ? dofs : 0);
+    plan_u_.assign(static_cast<std::size_t>(team_) + 1, zero);
+    plan_y_.assign(static_cast<std::size_t>(team_) + 1, zero);
+  }
   static Eigen::Matrix3d read_block(const CgVectors<Real>& cg, int lane) {
     const auto q = [&](int e) { return static_cast<double>(cg.inverse_block[e][lane]); };
     Eigen::Matrix3d m;
@@ -239,6 +313,10 @@ class ImplicitFields {
   // per member, per node: its part of h D_F + h² K_F
   std::vector<std::vector<Eigen::Matrix3d>> blocks_part_;
   std::vector<double> member_dots_;
+  bool rows_ = false;
+  std::vector<std::vector<Node>> plan_nodes_;       // per plan, by block
+  std::vector<std::vector<int>> plan_block_start_;  // per plan, per block + 1
+  std::vector<Eigen::VectorXd> plan_u_, plan_y_;    // per plan: h u at every field node, its rows
 };
 
 }  // namespace msfem::massspring::detail

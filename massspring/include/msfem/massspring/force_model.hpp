@@ -148,6 +148,14 @@ class ForceField : public ForceModel {
     virtual bool add_force_part(Eigen::VectorXd& /*f*/, int /*part*/, int /*parts*/) const {
       return false;
     }
+    /// Rows instead of parts, for a caller that shares the nodes among its threads: plan p is to
+    /// give the rows of the nodes in plans[p], each row whole, so that no thread sums other
+    /// threads' parts. The tangent may lay its work out in the plans' order (the first plan's
+    /// nodes first). False, nothing planned, where the tangent has no rows (by default) or its
+    /// field has a velocity term (∂f/∂v ≠ 0), which rows do not give.
+    virtual bool plan_rows(const std::vector<std::vector<int>>& /*plans*/) { return false; }
+    virtual void add_product_rows(const Eigen::VectorXd& /*dx*/, Eigen::VectorXd& /*df*/,
+                                  int /*plan*/) const {}
   };
   /// A tangent at the state in x and v, which must outlive it. By default it multiplies with
   /// add_dfdx_product_part at each product, which suits a field whose product costs little beside
