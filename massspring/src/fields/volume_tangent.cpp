@@ -1,7 +1,8 @@
 // The volume field's kept definite tangent (VolumeForceField::tangent): the gradients of one
 // linearisation point, kept in the field's lane groups (volume_batches.hpp) so that every product
 // of a solve is a vector pass over a group's lanes — a gather, a dot product per lane, a scatter —
-// instead of one element at a time.
+// instead of one element at a time. With rows planned, a thread's product is the dot products of
+// the groups at its nodes and then each of its nodes' sum over its elements: no scatter.
 
 #include <algorithm>
 #include <cmath>

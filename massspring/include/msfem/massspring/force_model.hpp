@@ -152,8 +152,10 @@ class ForceField : public ForceModel {
     /// give the rows of the nodes in plans[p], each row whole, so that no thread sums other
     /// threads' parts. The tangent may lay its work out in the plans' order (the first plan's
     /// nodes first). False, nothing planned, where the tangent has no rows (by default) or its
-    /// field has a velocity term (∂f/∂v ≠ 0), which rows do not give.
+    /// field has a velocity term (∂f/∂v ≠ 0), which rows do not give. Called before set_part.
     virtual bool plan_rows(const std::vector<std::vector<int>>& /*plans*/) { return false; }
+    /// df += (∂f/∂x) dx at the rows of plan `plan`, the other entries untouched, once set_part has
+    /// run for every part; dx must hold every one of the field's nodes.
     virtual void add_product_rows(const Eigen::VectorXd& /*dx*/, Eigen::VectorXd& /*df*/,
                                   int /*plan*/) const {}
   };
