@@ -62,7 +62,8 @@ JacobianErrors check_force_jacobians(const ForceModel& model, const Eigen::Vecto
 
 double FieldCallErrors::worst() const {
   return std::max({force_parts, product_parts, diagonal_blocks, tangent_product,
-                   tangent_pair_product, tangent_blocks, tangent_force, outside_nodes});
+                   tangent_pair_product, tangent_blocks, tangent_force, tangent_rows,
+                   outside_nodes});
 }
 
 FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd& x,
@@ -89,6 +90,14 @@ FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd
   };
   auto worse = [](double& slot, double value) { slot = std::max(slot, value); };
 
+  // Rows, where the tangent plans them: the even nodes, the odd ones (so that an element or a
+  // contact point straddles the two), all of them.
+  std::vector<std::vector<int>> plans(3);
+  for (int i = 0; i < nodes; ++i) {
+    plans[std::size_t(i % 2)].push_back(i);
+    plans[2].push_back(i);
+  }
+
   FieldCallErrors e;
   std::vector<Eigen::Matrix3d> blocks(nodes, Eigen::Matrix3d::Zero());
   field.add_diagonal_blocks(x, v, cx, cv, blocks, definite);
@@ -97,6 +106,7 @@ FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd
     Eigen::VectorXd f = Eigen::VectorXd::Zero(n), df = f, tf = f, tdf = f, tdf1 = f, tdf2 = f;
     std::vector<Eigen::Matrix3d> tangent_blocks(nodes, Eigen::Matrix3d::Zero());
     const auto tangent = field.tangent(x, v, definite);
+    const bool rows = tangent->plan_rows(plans);
     bool gives_force = true;
     for (int part = 0; part < parts; ++part) {
       field.add_force_part(x, v, f, part, parts);
@@ -115,6 +125,14 @@ FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd
     worse(e.tangent_pair_product, std::max(relative(product, tdf1), relative(product2, tdf2)));
     worse(e.tangent_blocks, relative(blocks_expected, stacked(tangent_blocks)));
     if (gives_force) worse(e.tangent_force, relative(force, tf));
+    for (std::size_t plan = 0; rows && plan < plans.size(); ++plan) {
+      // A plan's rows are the product's at its nodes; the other entries keep what they held.
+      Eigen::VectorXd expected = Eigen::VectorXd::Constant(n, 7.0), got = expected;
+      for (int i : plans[plan])
+        expected.segment<3>(3 * i) += product.segment<3>(3 * i);
+      tangent->add_product_rows(dx, got, static_cast<int>(plan));
+      worse(e.tangent_rows, (got - expected).norm() / product.norm());
+    }
   }
   std::vector<char> on(nodes, 0);
   for (int i : field.nodes())

@@ -38,6 +38,7 @@ struct FieldCallErrors {
   double tangent_pair_product = 0.0;
   double tangent_blocks = 0.0;
   double tangent_force = 0.0;
+  double tangent_rows = 0.0;   ///< where the tangent plans rows (ForceField::Tangent::plan_rows)
   double outside_nodes = 0.0;  ///< |force and product off the field's nodes| / |force|
   double worst() const;
 };

@@ -97,7 +97,7 @@ TEST(OutsideField, EveryFieldAnswersASolversCallsAsTheWholeCalls) {
         << name << ": parts " << calls.force_parts << " " << calls.product_parts << ", blocks "
         << calls.diagonal_blocks << ", tangent " << calls.tangent_product << " "
         << calls.tangent_pair_product << " " << calls.tangent_blocks << " " << calls.tangent_force
-        << ", outside " << calls.outside_nodes;
+        << " rows " << calls.tangent_rows << ", outside " << calls.outside_nodes;
   }
 }
 

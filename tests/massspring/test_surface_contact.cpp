@@ -1,6 +1,7 @@
 // The sphere against the surface's triangles: Jacobians and energy by finite differences (alone
-// and in the composed model of springs, volume elements and contact), the closed-form force of a
-// tool pressed on a triangle's centre, and the broad phase.
+// and in the composed model of springs, volume elements and contact), the fast implicit stepper
+// stepping that model as the generic backward Euler, the closed-form force of a tool pressed on a
+// triangle's centre, and the broad phase.
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,8 @@
 #include "force_jacobian_check.hpp"
 #include "icosphere.hpp"
 #include "msfem/massspring/errors.hpp"
+#include "msfem/massspring/fast_implicit_stepper.hpp"
+#include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/surface_contact.hpp"
 #include "msfem/massspring/topology_builders.hpp"
@@ -63,6 +66,56 @@ TEST(SurfaceContact, ComposedModelOfSpringsVolumeAndContactMatchesFiniteDifferen
   EXPECT_LE(errors.dfdv_matrix, 1e-6);
   EXPECT_LE(errors.dfdv_product, 1e-6);
   EXPECT_LE(errors.energy_gradient, 1e-5);
+}
+
+// The fast implicit stepper carries the contact and the volume in its CG products (by rows: each
+// thread its own nodes' whole rows) and takes the generic backward Euler's steps, on one and two
+// threads. The tool presses a face between its nodes, so that no node enters it: the generic
+// integrator projects nodes out of the tool after each step, which the fast steppers do not.
+TEST(SurfaceContact, FastImplicitStepsTheContactAsTheGenericBackwardEuler) {
+  const auto mesh = icosphere(1, 0.05);
+  ThreeTierOptions options;
+  options.material.youngs_modulus = 3000.0;
+  options.material.spring_damping = 0.05;
+  MassSpringModel model(build_three_tier(mesh.vertices, mesh.triangles, options));
+  const int nv = int(mesh.vertices.rows());
+  model.set_volume(VolumeForceField(
+      model.num_nodes(),
+      tier_prisms(model.network().rest_positions, model.network().surface_triangles, nv, 3, 8e3)));
+  model.set_gravity({0.0, 0.0, -9.81});
+  const Eigen::Vector3d centroid =
+      (mesh.vertices.row(mesh.triangles(0, 0)) + mesh.vertices.row(mesh.triangles(0, 1)) +
+       mesh.vertices.row(mesh.triangles(0, 2)))
+          .transpose() /
+      3.0;
+  ToolIndentation indent;
+  indent.contact_point = centroid;
+  indent.inward_direction = -centroid.normalized();
+  indent.radius = 0.004;
+  indent.depth = 0.001;
+  activate_surface_contact(model, indent);
+  const State start{model.rest_state(), Eigen::VectorXd::Zero(model.num_dofs()), 0.0};
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(model.num_dofs());
+  model.contact()->add_force(start.x, start.v, f);
+  ASSERT_GT(f.norm(), 0.0);
+  State backward = start;
+  Integrator generic(IntegratorKind::implicit_euler, {1e-13, 5000});
+  const SphereTool& tool = model.contact()->tool();
+  for (int n = 0; n < 20; ++n) {
+    generic.step(model, backward, 1e-3);
+    for (int i : model.contact()->nodes())
+      ASSERT_GT((backward.x.segment<3>(3 * i) - tool.center).norm(), tool.radius) << n << " " << i;
+  }
+  const double travel = (backward.x - start.x).norm();
+  ASSERT_GT(travel, 1e-6);
+  for (const int threads : {1, 2}) {
+    FastImplicitStepper fast(model, FastImplicitOptions{threads, true, 1e-13, 5000});
+    fast.set_state(start);
+    for (int n = 0; n < 20; ++n)
+      fast.step(1e-3);
+    EXPECT_LT((fast.state().x - backward.x).norm(), 1e-8 * travel) << threads;
+    EXPECT_LT((fast.state().v - backward.v).norm(), 1e-8 * backward.v.norm()) << threads;
+  }
 }
 
 /// An equilateral triangle in z = 0 (circumradius 3r), closed into a flat tetrahedron-free

@@ -61,25 +61,13 @@ TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
 
 // The kept tangent (each element's gradient and volume stored once) multiplies, gives the diagonal
 // blocks and the force, as the definite calls that recompute them, in one part and shared by three,
-// and follows the state it was made with when set again. With rows planned (the elements grouped
-// anew), all of that holds as well, and each plan's rows are the product's at its nodes, the other
-// rows untouched: the even nodes, the odd ones (every group straddles the two), all of them.
-void expect_one_tangent_as_recomputed(const VolumeForceField& volume, const Eigen::VectorXd& x0,
-                                      bool planned) {
-  Eigen::VectorXd x = x0;
+// and follows the state it was made with when set again.
+void expect_kept_tangent_as_recomputed(const VolumeForceField& volume, Eigen::VectorXd x) {
   const Eigen::Index n = x.size();
   const Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
   const Eigen::VectorXd dx = perturbed(Eigen::VectorXd::Zero(n), 0.001, 5);
   const Eigen::VectorXd dx2 = perturbed(Eigen::VectorXd::Zero(n), 0.001, 9);
   const auto tangent = volume.tangent(x, v, Linearisation::definite);
-  std::vector<std::vector<int>> plans(3);
-  for (int node = 0; node < n / 3; ++node) {
-    plans[node % 2].push_back(node);
-    plans[2].push_back(node);
-  }
-  if (planned) {
-    ASSERT_TRUE(tangent->plan_rows(plans));
-  }
   const auto close = [](const Eigen::VectorXd& got, const Eigen::VectorXd& want) {
     return (got - want).norm() <= 1e-12 * want.norm() && want.norm() > 0.0;
   };
@@ -101,19 +89,6 @@ void expect_one_tangent_as_recomputed(const VolumeForceField& volume, const Eige
       EXPECT_TRUE(close(pair1, expected)) << parts << " " << round;
       EXPECT_TRUE(close(pair2, expected2)) << parts << " " << round;
       EXPECT_TRUE(close(kept_force, force)) << parts << " " << round;
-      if (planned) {
-        for (std::size_t plan = 0; plan < plans.size(); ++plan) {
-          Eigen::VectorXd rows = Eigen::VectorXd::Constant(n, 7.0);
-          std::vector<char> in(static_cast<std::size_t>(n / 3), 0);
-          for (int node : plans[plan])
-            in[static_cast<std::size_t>(node)] = 1;
-          tangent->add_product_rows(dx, rows, static_cast<int>(plan));
-          for (Eigen::Index k = 0; k < n; ++k)
-            ASSERT_NEAR(rows[k], in[static_cast<std::size_t>(k / 3)] ? 7.0 + expected[k] : 7.0,
-                        1e-12 * expected.norm())
-                << "plan " << plan << " dof " << k;
-        }
-      }
       const int nodes = static_cast<int>(n / 3);
       std::vector<Eigen::Matrix3d> blocks(nodes, Eigen::Matrix3d::Zero()), recomputed = blocks;
       for (int part = 0; part < parts; ++part)
@@ -129,11 +104,6 @@ void expect_one_tangent_as_recomputed(const VolumeForceField& volume, const Eige
     }
     x = perturbed(x, 0.002, 7);  // the next round's state, read through the same tangent
   }
-}
-
-void expect_kept_tangent_as_recomputed(const VolumeForceField& volume, const Eigen::VectorXd& x0) {
-  for (const bool planned : {false, true})
-    expect_one_tangent_as_recomputed(volume, x0, planned);
 }
 
 TEST(VolumeForceField, KeptTangentMultipliesAsTheRecomputedProduct) {

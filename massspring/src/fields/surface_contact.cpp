@@ -206,6 +206,7 @@ class KeptContactTangent final : public ForceField::Tangent {
   void set_part(int part, int parts) override {
     if (parts > kMaxParts)
       throw ModelError("surface contact tangent: at most " + std::to_string(kMaxParts) + " parts");
+    if (part == 0) parts_ = parts;  // read by the rows after every part is set
     std::vector<Point>& points = points_[std::size_t(part)];
     points.clear();
     field_->for_each_contact_point(
@@ -235,6 +236,33 @@ class KeptContactTangent final : public ForceField::Tangent {
     }
   }
 
+  // A row sums the points on the triangles at its node; the points are few (those inside the
+  // tool), so each plan walks every part's list and keeps its own nodes' share.
+  bool plan_rows(const std::vector<std::vector<int>>& plans) override {
+    in_plan_.assign(plans.size(), std::vector<char>(std::size_t(x_->size() / 3), 0));
+    for (std::size_t plan = 0; plan < plans.size(); ++plan)
+      for (int node : plans[plan])
+        in_plan_[plan][std::size_t(node)] = 1;
+    return true;
+  }
+
+  void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
+    const std::vector<char>& in = in_plan_[std::size_t(plan)];
+    for (int part = 0; part < parts_; ++part)
+      for (const Point& p : points_[std::size_t(part)]) {
+        const bool at[3] = {in[std::size_t(p.offset[0] / 3)] != 0,
+                            in[std::size_t(p.offset[1] / 3)] != 0,
+                            in[std::size_t(p.offset[2] / 3)] != 0};
+        if (!at[0] && !at[1] && !at[2]) continue;
+        Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+        for (int l = 0; l < 3; ++l)
+          moved += p.b[l] * dx.segment<3>(p.offset[l]);
+        const Eigen::Vector3d change = p.stiffness * moved;
+        for (int k = 0; k < 3; ++k)
+          if (at[k]) df.segment<3>(p.offset[k]) += p.b[k] * change;
+      }
+  }
+
   // Frictionless: no velocity term, cv does not enter.
   void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
                                 int) const override {
@@ -262,6 +290,8 @@ class KeptContactTangent final : public ForceField::Tangent {
   const Eigen::VectorXd* x_;
   Linearisation mode_;
   std::vector<std::vector<Point>> points_;  // per part
+  int parts_ = 0;                           // of the last set_part
+  std::vector<std::vector<char>> in_plan_;  // per plan and node: whether its row is the plan's
 };
 
 std::unique_ptr<ForceField::Tangent> SurfaceContactForceField::tangent(const Eigen::VectorXd& x,
