@@ -23,6 +23,7 @@ namespace {
 using testing::check_force_jacobians;
 using testing::icosphere;
 using testing::perturbed;
+using testing::TriangleMesh;
 
 TEST(SurfaceContact, JacobiansAndEnergyMatchFiniteDifferences) {
   const auto mesh = icosphere(2, 0.05);
@@ -39,8 +40,9 @@ TEST(SurfaceContact, JacobiansAndEnergyMatchFiniteDifferences) {
   EXPECT_LE(errors.energy_gradient, 1e-5);
 }
 
-TEST(SurfaceContact, ComposedModelOfSpringsVolumeAndContactMatchesFiniteDifferences) {
-  const auto mesh = icosphere(1, 0.05);
+// The level-1 sphere's three tiers, damped, with volume preservation on their shells and gravity:
+// every kind of force beside the contact.
+MassSpringModel composed_sphere(const TriangleMesh& mesh) {
   ThreeTierOptions options;
   options.material.youngs_modulus = 3000.0;
   options.material.spring_damping = 0.05;
@@ -50,6 +52,12 @@ TEST(SurfaceContact, ComposedModelOfSpringsVolumeAndContactMatchesFiniteDifferen
       model.num_nodes(),
       tier_prisms(model.network().rest_positions, model.network().surface_triangles, nv, 3, 8e3)));
   model.set_gravity({0.0, 0.0, -9.81});
+  return model;
+}
+
+TEST(SurfaceContact, ComposedModelOfSpringsVolumeAndContactMatchesFiniteDifferences) {
+  const auto mesh = icosphere(1, 0.05);
+  MassSpringModel model = composed_sphere(mesh);
   ToolIndentation indent;
   indent.contact_point = {0.0, 0.0, 0.05};
   indent.radius = 0.01;
@@ -74,15 +82,7 @@ TEST(SurfaceContact, ComposedModelOfSpringsVolumeAndContactMatchesFiniteDifferen
 // integrator projects nodes out of the tool after each step, which the fast steppers do not.
 TEST(SurfaceContact, FastImplicitStepsTheContactAsTheGenericBackwardEuler) {
   const auto mesh = icosphere(1, 0.05);
-  ThreeTierOptions options;
-  options.material.youngs_modulus = 3000.0;
-  options.material.spring_damping = 0.05;
-  MassSpringModel model(build_three_tier(mesh.vertices, mesh.triangles, options));
-  const int nv = int(mesh.vertices.rows());
-  model.set_volume(VolumeForceField(
-      model.num_nodes(),
-      tier_prisms(model.network().rest_positions, model.network().surface_triangles, nv, 3, 8e3)));
-  model.set_gravity({0.0, 0.0, -9.81});
+  MassSpringModel model = composed_sphere(mesh);
   const Eigen::Vector3d centroid =
       (mesh.vertices.row(mesh.triangles(0, 0)) + mesh.vertices.row(mesh.triangles(0, 1)) +
        mesh.vertices.row(mesh.triangles(0, 2)))
