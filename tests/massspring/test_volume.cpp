@@ -196,12 +196,15 @@ TEST(VolumeForceField, MixedShapesInPartialLaneGroupsMatchFiniteDifferences) {
   EXPECT_LE(errors.dfdx_matrix, 1e-6);
   EXPECT_LE(errors.dfdx_product, 1e-6);
   EXPECT_LE(errors.energy_gradient, 1e-6);
-  // Three parts sum to the whole force.
+  // Three parts sum to the whole force; every call a solver makes, the kept tangent's rows
+  // among them (its elements grouped anew), answers as the whole calls.
   Eigen::VectorXd f = Eigen::VectorXd::Zero(x.size()), parts = f;
   volume.add_force(x, Eigen::VectorXd::Zero(x.size()), f);
   for (int part = 0; part < 3; ++part)
     volume.add_force_part(x, Eigen::VectorXd::Zero(x.size()), parts, part, 3);
   EXPECT_LE((parts - f).norm(), 1e-13 * f.norm());
+  const auto calls = testing::check_field_calls(volume, x, Eigen::VectorXd::Zero(x.size()));
+  EXPECT_LT(calls.worst(), 1e-12) << "rows " << calls.tangent_rows;
 }
 
 TEST(VolumeForceField, PrismsFillTheShellsBetweenTheTiers) {
