@@ -130,7 +130,7 @@ inline bool cpu_has_avx2() {
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }
 inline bool cpu_has_avx512() {
-  return cpu_has_avx2() && __builtin_cpu_supports("avx512f");
+  return cpu_has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
 }
 #else
 inline bool cpu_has_avx2() {
@@ -154,22 +154,26 @@ int preferred_lanes(bool allow_avx512, long springs, long nodes) {
 }
 
 #if MSFEM_HAVE_X86_DISPATCH
-#define MSFEM_DISPATCH(NAME, ...)                           \
-  if constexpr (W == 16) {                                  \
-    return NAME##_avx512<Avx512Float>(__VA_ARGS__);         \
-  } else if constexpr (W == 32 / sizeof(Real)) {            \
-    if (avx2_) return NAME##_avx2<Avx2<Real>>(__VA_ARGS__); \
-  }                                                         \
+#define MSFEM_DISPATCH(NAME, ...)                                     \
+  if constexpr (W == 16) {                                            \
+    return NAME##_avx512<Avx512Float>(__VA_ARGS__);                   \
+  } else if constexpr (W == 32 / sizeof(Real)) {                      \
+    if constexpr (std::is_same_v<Real, double>)                       \
+      if (avx512_) return NAME##_avx512<Avx512VlDouble>(__VA_ARGS__); \
+    if (avx2_) return NAME##_avx2<Avx2<Real>>(__VA_ARGS__);           \
+  }                                                                   \
   return NAME##_portable<PortableLanes<Real, W>>(__VA_ARGS__)
 #else
 #define MSFEM_DISPATCH(NAME, ...) return NAME##_portable<PortableLanes<Real, W>>(__VA_ARGS__)
 #endif
 
-// The kernels for one precision and lane count, the instruction set chosen once.
+// The kernels for one precision and lane count, the instruction set chosen once. Double takes
+// AVX-512VL's inverse square root where the CPU has it and `allow_avx512` (Avx512VlDouble).
 template <class Real, int W>
 class Kernels {
  public:
-  Kernels() : avx2_(cpu_has_avx2()) {}
+  explicit Kernels(bool allow_avx512 = true)
+      : avx2_(cpu_has_avx2()), avx512_(allow_avx512 && cpu_has_avx512()) {}
 
   // symplectic false: explicit Euler (x advances with the step's starting v).
   double explicit_step(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next, int begin,
@@ -248,6 +252,10 @@ class Kernels {
     if constexpr (W == 16) {
       return explicit_chunks_avx512<Avx512Float, Damped, Symplectic>(g, cur, next, begin, end, h);
     } else if constexpr (W == 32 / sizeof(Real)) {
+      if constexpr (std::is_same_v<Real, double>)
+        if (avx512_)
+          return explicit_chunks_avx512<Avx512VlDouble, Damped, Symplectic>(g, cur, next, begin,
+                                                                            end, h);
       if (avx2_)
         return explicit_chunks_avx2<Avx2<Real>, Damped, Symplectic>(g, cur, next, begin, end, h);
     }
@@ -277,6 +285,10 @@ class Kernels {
       return rk4_stage_chunks_avx512<Avx512Float, Damped, Stage>(g, in, base, out, acc, begin, end,
                                                                  c, w);
     } else if constexpr (W == 32 / sizeof(Real)) {
+      if constexpr (std::is_same_v<Real, double>)
+        if (avx512_)
+          return rk4_stage_chunks_avx512<Avx512VlDouble, Damped, Stage>(g, in, base, out, acc,
+                                                                        begin, end, c, w);
       if (avx2_)
         return rk4_stage_chunks_avx2<Avx2<Real>, Damped, Stage>(g, in, base, out, acc, begin, end,
                                                                 c, w);
@@ -295,6 +307,10 @@ class Kernels {
       return linearise_start_chunks_avx512<Avx512Float, Damped>(g, records, dv_records, sys, cg,
                                                                 p_records, begin, end, h, sums);
     } else if constexpr (W == 32 / sizeof(Real)) {
+      if constexpr (std::is_same_v<Real, double>)
+        if (avx512_)
+          return linearise_start_chunks_avx512<Avx512VlDouble, Damped>(
+              g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
       if (avx2_)
         return linearise_start_chunks_avx2<Avx2<Real>, Damped>(g, records, dv_records, sys, cg,
                                                                p_records, begin, end, h, sums);
@@ -304,7 +320,7 @@ class Kernels {
         g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
   }
 
-  bool avx2_;
+  bool avx2_, avx512_;
 };
 
 #undef MSFEM_DISPATCH

@@ -50,7 +50,8 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         gather_(soa_),
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))},
-        integrator_(options.integrator) {
+        integrator_(options.integrator),
+        kernels_(options.allow_avx512) {
     if (integrator_ == IntegratorKind::rk4)
       for (auto& stage : stages_)
         stage.resize(records_[0].size());

@@ -13,7 +13,9 @@ struct FastStepperOptions {
   int threads = 2;                ///< threads in all, the calling one included
   bool single_precision = false;  ///< float arithmetic (twice the SIMD width, ~1e-7 relative)
   bool reorder_nodes = true;      ///< reverse Cuthill-McKee order for memory locality
-  bool allow_avx512 = true;       ///< float: 16 lanes where the CPU has AVX-512 (else 8, AVX2)
+  /// float: 16 lanes where the CPU has AVX-512 (else 8, AVX2); double: 1/√ from AVX-512VL's
+  /// estimate refined to a few ulp (else a square root and a division)
+  bool allow_avx512 = true;
   /// The scheme, as the generic Integrator of the same kind steps it: symplectic_euler,
   /// explicit_euler (x ← x + h v with the step's starting v, at the symplectic step's cost) or rk4
   /// (four force passes a step). Others throw ModelError; central_difference is symplectic_euler
