@@ -191,11 +191,11 @@ struct Avx2Double {
 };
 
 // Double on a CPU with AVX-512VL: the AVX2 lanes, but 1/√ from the hardware's 14-bit estimate and
-// two Newton steps (relative error ~2^-14 → ~1e-8 → a few ulp) instead of a square root and a
-// division, and √ from it. Those two share one unit, and in the brain's explicit step they were half its time:
-// the estimate and six multiplies run on the FMA pipes beside the rest of the spring's arithmetic.
-// The result differs from the exact 1/√ by a few ulp, far below what the fast steppers are tested
-// to (1e-9 of the generic integrators' trajectories).
+// two Newton steps (relative error ~2^-14, ~1e-8, then a few ulp) instead of a square root and a
+// division, and √ from it: those two share one unit, where the estimate and six multiplies run on
+// the FMA pipes beside the rest of the spring's arithmetic (4-5 % on a step, docs/design-notes.md).
+// A few ulp from the exact 1/√ is far below what the fast steppers are tested to (1e-9 of the
+// generic integrators' trajectories).
 struct Avx512VlDouble : Avx2Double {
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V inverse_sqrt(V a) {
     const V half_a = mul(set1(0.5), a);
