@@ -163,4 +163,40 @@ void scatter_group(const VolumeBatches& b, int group, const double* g, const dou
     }
 }
 
+MSFEM_LANE_CLONES void group_dot_pair(const VolumeBatches& b, int group, const double* g,
+                                      const double* x1, const double* x2, double* out1,
+                                      double* out2) {
+  const int nodes = b.nodes(group);
+  const int* offset = b.offset.data() + b.group_start[group];
+  alignas(64) double sum1[L] = {}, sum2[L] = {};
+  for (int k = 0; k < nodes; ++k) {
+    const int* at = offset + k * L;
+    const double* gk = g + 3 * k * L;
+    for (int l = 0; l < L; ++l) {
+      sum1[l] += gk[l] * x1[at[l]] + gk[L + l] * x1[at[l] + 1] + gk[2 * L + l] * x1[at[l] + 2];
+      sum2[l] += gk[l] * x2[at[l]] + gk[L + l] * x2[at[l] + 1] + gk[2 * L + l] * x2[at[l] + 2];
+    }
+  }
+  for (int l = 0; l < L; ++l) {
+    out1[l] = sum1[l];
+    out2[l] = sum2[l];
+  }
+}
+
+void scatter_group_pair(const VolumeBatches& b, int group, const double* g, const double* s1,
+                        double* f1, const double* s2, double* f2) {
+  const int nodes = b.nodes(group), lanes = b.group_lanes[group];
+  const int* offset = b.offset.data() + b.group_start[group];
+  for (int k = 0; k < nodes; ++k)
+    for (int l = 0; l < lanes; ++l) {
+      double* at1 = f1 + offset[k * L + l];
+      double* at2 = f2 + offset[k * L + l];
+      for (int c = 0; c < 3; ++c) {
+        const double gc = g[(3 * k + c) * L + l];
+        at1[c] += s1[l] * gc;
+        at2[c] += s2[l] * gc;
+      }
+    }
+}
+
 }  // namespace msfem::massspring::detail

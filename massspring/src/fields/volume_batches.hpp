@@ -58,4 +58,12 @@ void group_dot(const VolumeBatches& b, int group, const double* g, const double*
 /// f[node k of lane l] += s[l] g_k(l) for the group's filled lanes.
 void scatter_group(const VolumeBatches& b, int group, const double* g, const double* s, double* f);
 
+/// group_dot for two vectors in one pass over g: out1 from x1, out2 from x2.
+void group_dot_pair(const VolumeBatches& b, int group, const double* g, const double* x1,
+                    const double* x2, double* out1, double* out2);
+
+/// scatter_group for two vectors in one pass over g: f1 with s1, f2 with s2.
+void scatter_group_pair(const VolumeBatches& b, int group, const double* g, const double* s1,
+                        double* f1, const double* s2, double* f2);
+
 }  // namespace msfem::massspring::detail

@@ -28,20 +28,29 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
 
   // Gradients and volumes of this part's groups; the lanes a group does not fill keep scale 0.
   void set_part(int part, int parts) override {
-    const auto& elements = field_->elements_;
-    const auto [first, last] = batches_->group_range(part, parts);
-    for (int group = first; group < last; ++group) {
-      double volume[L];
-      detail::group_gradient(*batches_, group, x_->data(), gradient(group), volume);
+    for_each_group(part, parts, [&](int group) { set_group(group); });
+  }
+
+  // Group by group, each group's gradients still in the cache for the rest: f += pressure g / 6
+  // + K dx1 and df2 += K dx2 (one scatter each), and the group's diagonal blocks.
+  bool start_part(const Eigen::VectorXd& dx1, Eigen::VectorXd& f, const Eigen::VectorXd& dx2,
+                  Eigen::VectorXd& df2, double cx, double, std::vector<Eigen::Matrix3d>& blocks,
+                  int part, int parts) override {
+    for_each_group(part, parts, [&](int group) {
+      set_group(group);
+      const double* g = gradient(group);
+      double dot1[L], dot2[L];
+      detail::group_dot_pair(*batches_, group, g, dx1.data(), dx2.data(), dot1, dot2);
+      double s1[L], s2[L];
       for (int l = 0; l < L; ++l) {
         const std::size_t lane = static_cast<std::size_t>(group) * L + l;
-        const int e = batches_->element[lane];
-        const double rest = elements.rest_volume[e];
-        scale_[lane] =
-            l < batches_->group_lanes[group] ? elements.modulus[e] / std::abs(rest) : 0.0;
-        pressure_[lane] = scale_[lane] * (volume[l] - rest);
+        s1[l] = pressure_[lane] / 6.0 - scale_[lane] / 36.0 * dot1[l];
+        s2[l] = -scale_[lane] / 36.0 * dot2[l];
       }
-    }
+      detail::scatter_group_pair(*batches_, group, g, s1, f.data(), s2, df2.data());
+      add_group_blocks(group, cx, blocks);
+    });
+    return true;
   }
 
   void add_product_part(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int part,
@@ -108,6 +117,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
         p.row_start.push_back(static_cast<int>(p.lane.size()));
       }
       p.s.assign(scale_.size(), 0.0);
+      p.s2.assign(scale_.size(), 0.0);
     }
     return true;
   }
@@ -136,25 +146,121 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     }
   }
 
-  // The field has no velocity term: cv does not enter. blocks[i] −= cx κ/|V⁰| g_i g_iᵀ / 36.
+  bool starts_by_rows() const override { return true; }
+  // As add_product_rows, with two dot products per element and three sums per row.
+  void start_rows(const Eigen::VectorXd& dx1, Eigen::VectorXd& f, const Eigen::VectorXd& dx2,
+                  Eigen::VectorXd& df2, double cx, std::vector<Eigen::Matrix3d>& blocks,
+                  int plan) const override {
+    const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
+    for (int group : p.groups) {
+      double dot1[L], dot2[L];
+      detail::group_dot_pair(*batches_, group, gradient(group), dx1.data(), dx2.data(), dot1, dot2);
+      for (int l = 0; l < L; ++l) {
+        const std::size_t lane = static_cast<std::size_t>(group) * L + l;
+        p.s[lane] = pressure_[lane] / 6.0 - scale_[lane] / 36.0 * dot1[l];
+        p.s2[lane] = -scale_[lane] / 36.0 * dot2[l];
+      }
+    }
+    const double c = cx / 36.0;
+    for (std::size_t r = 0; r < p.rows.size(); ++r) {
+      double f1[3] = {0.0, 0.0, 0.0}, f2[3] = {0.0, 0.0, 0.0},
+             e[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+      for (int i = p.row_start[r]; i < p.row_start[r + 1]; ++i) {
+        const std::size_t lane = static_cast<std::size_t>(p.lane[i]);
+        const double* g = g_.data() + p.g_at[i];
+        const double gx = g[0], gy = g[L], gz = g[2 * L];
+        const double s1 = p.s[lane], s2 = p.s2[lane], k = c * scale_[lane];
+        f1[0] += s1 * gx;
+        f1[1] += s1 * gy;
+        f1[2] += s1 * gz;
+        f2[0] += s2 * gx;
+        f2[1] += s2 * gy;
+        f2[2] += s2 * gz;
+        const double kx = k * gx, ky = k * gy;
+        e[0] += kx * gx;
+        e[1] += ky * gy;
+        e[2] += k * gz * gz;
+        e[3] += kx * gy;
+        e[4] += kx * gz;
+        e[5] += ky * gz;
+      }
+      const int node = p.rows[r];
+      for (int q = 0; q < 3; ++q) {
+        f[3 * node + q] += f1[q];
+        df2[3 * node + q] += f2[q];
+      }
+      double* m = blocks[static_cast<std::size_t>(node)].data();  // column-major
+      m[0] -= e[0];
+      m[4] -= e[1];
+      m[8] -= e[2];
+      m[1] -= e[3];
+      m[3] -= e[3];
+      m[2] -= e[4];
+      m[6] -= e[4];
+      m[5] -= e[5];
+      m[7] -= e[5];
+    }
+  }
+
+  // The field has no velocity term: cv does not enter.
   void add_diagonal_blocks_part(double cx, double, std::vector<Eigen::Matrix3d>& blocks, int part,
                                 int parts) const override {
-    for_each_group(part, parts, [&](int group) {
-      const double* g = gradient(group);
-      const int* offset = batches_->offset.data() + batches_->group_start[group];
-      for (int k = 0; k < batches_->nodes(group); ++k)
-        for (int l = 0; l < batches_->group_lanes[group]; ++l) {
-          const double c = cx * scale_[static_cast<std::size_t>(group) * L + l] / 36.0;
-          const Eigen::Vector3d gk(g[3 * k * L + l], g[(3 * k + 1) * L + l],
-                                   g[(3 * k + 2) * L + l]);
-          blocks[static_cast<std::size_t>(offset[k * L + l] / 3)].noalias() -=
-              c * gk * gk.transpose();
-        }
-    });
+    for_each_group(part, parts, [&](int group) { add_group_blocks(group, cx, blocks); });
   }
 
  private:
   static constexpr int L = detail::kVolumeLanes;
+
+  void set_group(int group) {
+    const auto& elements = field_->elements_;
+    double volume[L];
+    detail::group_gradient(*batches_, group, x_->data(), gradient(group), volume);
+    for (int l = 0; l < L; ++l) {
+      const std::size_t lane = static_cast<std::size_t>(group) * L + l;
+      const int e = batches_->element[lane];
+      const double rest = elements.rest_volume[e];
+      scale_[lane] = l < batches_->group_lanes[group] ? elements.modulus[e] / std::abs(rest) : 0.0;
+      pressure_[lane] = scale_[lane] * (volume[l] - rest);
+    }
+  }
+
+  // blocks[i] −= cx κ/|V⁰| g_i g_iᵀ / 36 at the group's nodes: the six distinct entries over the
+  // lanes first (a vector loop), then added lane by lane.
+  void add_group_blocks(int group, double cx, std::vector<Eigen::Matrix3d>& blocks) const {
+    const double* g = gradient(group);
+    const int* offset = batches_->offset.data() + batches_->group_start[group];
+    const int lanes = batches_->group_lanes[group];
+    double c[L];
+    for (int l = 0; l < L; ++l)
+      c[l] = cx * scale_[static_cast<std::size_t>(group) * L + l] / 36.0;
+    for (int k = 0; k < batches_->nodes(group); ++k) {
+      const double* gx = g + 3 * k * L;
+      const double* gy = gx + L;
+      const double* gz = gy + L;
+      alignas(64) double e[6][L];
+      for (int l = 0; l < L; ++l) {
+        const double cgx = c[l] * gx[l], cgy = c[l] * gy[l];
+        e[0][l] = cgx * gx[l];
+        e[1][l] = cgy * gy[l];
+        e[2][l] = c[l] * gz[l] * gz[l];
+        e[3][l] = cgx * gy[l];
+        e[4][l] = cgx * gz[l];
+        e[5][l] = cgy * gz[l];
+      }
+      for (int l = 0; l < lanes; ++l) {
+        double* m = blocks[static_cast<std::size_t>(offset[k * L + l] / 3)].data();  // column-major
+        m[0] -= e[0][l];
+        m[4] -= e[1][l];
+        m[8] -= e[2][l];
+        m[1] -= e[3][l];
+        m[3] -= e[3][l];
+        m[2] -= e[4][l];
+        m[6] -= e[4][l];
+        m[5] -= e[5][l];
+        m[7] -= e[5][l];
+      }
+    }
+  }
 
   // df −= κ/|V⁰| (g·dx)/36 g over the group's lanes.
   void add_group_product(int group, const Eigen::VectorXd& dx, Eigen::VectorXd& df) const {
@@ -206,12 +312,13 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   const double* gradient(int group) const { return g_.data() + 3 * batches_->group_start[group]; }
 
   struct RowPlan {
-    std::vector<int> rows;          // the nodes
-    std::vector<int> row_start;     // per row + 1: its incidences
-    std::vector<int> lane;          // per incidence: its element's group lane (group·L + l)
-    std::vector<int> g_at;          // per incidence: where its g_x is in g_ (g_y, g_z L and 2L on)
-    std::vector<int> groups;        // the groups with an element at a row
-    mutable std::vector<double> s;  // per group lane: −κ/|V⁰| (g·dx)/36 at `groups`
+    std::vector<int> rows;           // the nodes
+    std::vector<int> row_start;      // per row + 1: its incidences
+    std::vector<int> lane;           // per incidence: its element's group lane (group·L + l)
+    std::vector<int> g_at;           // per incidence: where its g_x is in g_ (g_y, g_z L and 2L on)
+    std::vector<int> groups;         // the groups with an element at a row
+    mutable std::vector<double> s;   // per group lane: −κ/|V⁰| (g·dx)/36 at `groups`
+    mutable std::vector<double> s2;  // per group lane: start_rows's second factor
   };
 
   const VolumeForceField* field_;

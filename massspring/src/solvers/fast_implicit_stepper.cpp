@@ -141,13 +141,13 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
             std::copy(local, local + 3, out);
           },
           sums);
+      const int plan = fields_.member_plan(member, members);
       if (!fields_.empty()) {
         fields_.start_part(member, members, dt);
         if (members > 1) team_.barrier();
-        fields_.start_apply(b0, b1, members, cg_, p_records_.data(), dt);
+        fields_.start_apply(b0, b1, members, plan, cg_, p_records_.data(), dt);
         reduced([&](int block, double* out) { start_sums(block, out); }, sums);
       }
-      const int plan = fields_.member_plan(member, members);
       double gamma = sums[0], rr = sums[1], alpha = 0.0, previous_gamma = 0.0;
       const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
       int iteration = 0;

@@ -139,25 +139,55 @@ class ImplicitFields {
   // f_F + K_F (h v), of -A_F Δv / h = K_F (h Δv) + D_F Δv and of the diagonal blocks of
   // -A_F = h D_F + h² K_F. The parts are zero at every field node here: start_apply clears
   // what it reads.
+  // Where every tangent starts by rows, only their own parts (set_part): start_apply takes the
+  // rest by rows.
   void start_part(int member, int members, double h) {
+    if (start_rows_) {
+      for (const auto& tangent : tangents_)
+        tangent->set_part(member, members);
+      return;
+    }
     Eigen::VectorXd& b = b_part_[static_cast<std::size_t>(member)];
     Eigen::VectorXd& a = a_part_[static_cast<std::size_t>(member)];
     std::vector<Eigen::Matrix3d>& blocks = blocks_part_[static_cast<std::size_t>(member)];
     for (std::size_t k = 0; k < fields_.size(); ++k) {
-      tangents_[k]->set_part(member, members);
-      if (!tangents_[k]->add_force_part(b, member, members))
-        fields_[k]->add_force_part(x_, v_, b, member, members);
-      tangents_[k]->add_product_pair_part(hv_, b, hdv_, a, member, members);
+      ForceField::Tangent& tangent = *tangents_[k];
+      if (!tangent.start_part(hv_, b, hdv_, a, h * h, h, blocks, member, members)) {
+        tangent.set_part(member, members);
+        if (!tangent.add_force_part(b, member, members))
+          fields_[k]->add_force_part(x_, v_, b, member, members);
+        tangent.add_product_pair_part(hv_, b, hdv_, a, member, members);
+        tangent.add_diagonal_blocks_part(h * h, h, blocks, member, members);
+      }
       if (member == 0) fields_[k]->add_dfdv_product(x_, dv_, a);
-      tangents_[k]->add_diagonal_blocks_part(h * h, h, blocks, member, members);
     }
   }
 
   // After the next barrier, at this member's field lanes: b += b_F, r += b_F - A_F Δv, the
-  // preconditioner's block B += A_F (re-inverted), u = B⁻¹ r into cg.p and `u_records`. Clears
-  // the parts it reads at this member's nodes, so that no member zeroes a whole part each step.
-  void start_apply(int b0, int b1, int members, const CgVectors<Real>& cg, Real* u_records,
-                   double h) {
+  // preconditioner's block B += A_F (re-inverted), u = B⁻¹ r into cg.p and `u_records`. Where
+  // they start by rows, the tangents give b_F, A_F Δv and the blocks at the rows of plan `plan`;
+  // else this
+  // clears the parts it reads at this member's nodes, so that no member zeroes a whole part each
+  // step.
+  void start_apply(int b0, int b1, int members, int plan, const CgVectors<Real>& cg,
+                   Real* u_records, double h) {
+    if (start_rows_) {
+      const std::size_t p = static_cast<std::size_t>(plan);
+      Eigen::VectorXd& b = plan_u_[p];  // free until the products
+      Eigen::VectorXd& a = plan_y_[p];
+      std::vector<Eigen::Matrix3d>& blocks = plan_blocks_[p];
+      for (const Node& n : plan_nodes_[p]) {
+        b.template segment<3>(3 * n.node).setZero();
+        a.template segment<3>(3 * n.node).setZero();
+        blocks[static_cast<std::size_t>(n.node)].setZero();
+      }
+      for (const auto& tangent : tangents_)
+        tangent->start_rows(hv_, b, hdv_, a, h * h, blocks, plan);
+      for (const Node& n : plan_nodes_[p])
+        apply_start(n, b.template segment<3>(3 * n.node), a.template segment<3>(3 * n.node),
+                    blocks[static_cast<std::size_t>(n.node)], cg, u_records, h);
+      return;
+    }
     for (const Node& n : owned(b0, b1)) {
       Eigen::Vector3d b_field = Eigen::Vector3d::Zero(), a_field = Eigen::Vector3d::Zero();
       Eigen::Matrix3d field_block = Eigen::Matrix3d::Zero();
@@ -173,21 +203,7 @@ class ImplicitFields {
         a_part.setZero();
         block.setZero();
       }
-      if (n.lane < 0) continue;
-      Eigen::Vector3d r;
-      for (int c = 0; c < 3; ++c) {
-        cg.b[c][n.lane] += static_cast<Real>(h * b_field[c]);
-        cg.r[c][n.lane] += static_cast<Real>(h * (b_field[c] + a_field[c]));
-        r[c] = cg.r[c][n.lane];
-      }
-      const Eigen::Matrix3d block = read_block(cg, n.lane).inverse() - field_block;
-      const Eigen::Matrix3d inverse = block.inverse();
-      write_block(cg, n.lane, inverse);
-      const Eigen::Vector3d u = inverse * r;
-      for (int c = 0; c < 3; ++c) {
-        cg.p[c][n.lane] = static_cast<Real>(u[c]);
-        u_records[kDirection * n.id + c] = static_cast<Real>(u[c]);
-      }
+      if (n.lane >= 0) apply_start(n, b_field, a_field, field_block, cg, u_records, h);
     }
   }
 
@@ -274,6 +290,9 @@ class ImplicitFields {
     }
     for (const auto& tangent : tangents_)
       rows_ = tangent->plan_rows(rows) && rows_;
+    start_rows_ = rows_;
+    for (const auto& tangent : tangents_)
+      start_rows_ = start_rows_ && tangent->starts_by_rows();
     // Per plan and block: where the block's nodes start in the plan's (nodes are by block).
     plan_block_start_.assign(static_cast<std::size_t>(team_) + 1, {});
     for (int plan = 0; plan <= team_; ++plan) {
@@ -288,6 +307,29 @@ class ImplicitFields {
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(rows_ ? dofs : 0);
     plan_u_.assign(static_cast<std::size_t>(team_) + 1, zero);
     plan_y_.assign(static_cast<std::size_t>(team_) + 1, zero);
+    plan_blocks_.assign(static_cast<std::size_t>(team_) + 1,
+                        std::vector<Eigen::Matrix3d>(rows_ ? static_cast<std::size_t>(dofs / 3) : 0,
+                                                     Eigen::Matrix3d::Zero()));
+  }
+  // At node n's lane, from the fields' b_F / h, -A_F Δv / h and diagonal block of -A_F.
+  static void apply_start(const Node& n, const Eigen::Ref<const Eigen::Vector3d>& b_field,
+                          const Eigen::Ref<const Eigen::Vector3d>& a_field,
+                          const Eigen::Matrix3d& field_block, const CgVectors<Real>& cg,
+                          Real* u_records, double h) {
+    Eigen::Vector3d r;
+    for (int c = 0; c < 3; ++c) {
+      cg.b[c][n.lane] += static_cast<Real>(h * b_field[c]);
+      cg.r[c][n.lane] += static_cast<Real>(h * (b_field[c] + a_field[c]));
+      r[c] = cg.r[c][n.lane];
+    }
+    const Eigen::Matrix3d block = read_block(cg, n.lane).inverse() - field_block;
+    const Eigen::Matrix3d inverse = block.inverse();
+    write_block(cg, n.lane, inverse);
+    const Eigen::Vector3d u = inverse * r;
+    for (int c = 0; c < 3; ++c) {
+      cg.p[c][n.lane] = static_cast<Real>(u[c]);
+      u_records[kDirection * n.id + c] = static_cast<Real>(u[c]);
+    }
   }
   static Eigen::Matrix3d read_block(const CgVectors<Real>& cg, int lane) {
     const auto q = [&](int e) { return static_cast<double>(cg.inverse_block[e][lane]); };
@@ -314,9 +356,11 @@ class ImplicitFields {
   std::vector<std::vector<Eigen::Matrix3d>> blocks_part_;
   std::vector<double> member_dots_;
   bool rows_ = false;
+  bool start_rows_ = false;                         // rows, and every tangent starts a step by rows
   std::vector<std::vector<Node>> plan_nodes_;       // per plan, by block
   std::vector<std::vector<int>> plan_block_start_;  // per plan, per block + 1
   std::vector<Eigen::VectorXd> plan_u_, plan_y_;    // per plan: h u at every field node, its rows
+  std::vector<std::vector<Eigen::Matrix3d>> plan_blocks_;  // per plan: the fields' blocks by row
 };
 
 }  // namespace msfem::massspring::detail

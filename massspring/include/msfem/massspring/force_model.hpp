@@ -141,6 +141,16 @@ class ForceField : public ForceModel {
       add_product_part(dx1, df1, part, parts);
       add_product_part(dx2, df2, part, parts);
     }
+    /// Part `part` of `parts` of the start of a backward-Euler step in one pass, for a tangent
+    /// that can do it while each element's data is at hand: set_part(part, parts), then
+    /// f += f(x, v) + (∂f/∂x) dx1, df2 += (∂f/∂x) dx2 and add_diagonal_blocks_part(cx, cv,
+    /// blocks, part, parts). False, nothing done (by default): the caller makes those calls.
+    virtual bool start_part(const Eigen::VectorXd& /*dx1*/, Eigen::VectorXd& /*f*/,
+                            const Eigen::VectorXd& /*dx2*/, Eigen::VectorXd& /*df2*/, double /*cx*/,
+                            double /*cv*/, std::vector<Eigen::Matrix3d>& /*blocks*/, int /*part*/,
+                            int /*parts*/) {
+      return false;
+    }
     /// Part `part` of `parts` of the field's force at the tangent's state, f += f(x, v), from
     /// what set_part found there (a volume's gradient holds its force too). False, f untouched,
     /// where the tangent keeps nothing that gives it: the caller asks the field
@@ -158,6 +168,15 @@ class ForceField : public ForceModel {
     /// run for every part; dx must hold every one of the field's nodes.
     virtual void add_product_rows(const Eigen::VectorXd& /*dx*/, Eigen::VectorXd& /*df*/,
                                   int /*plan*/) const {}
+    /// Whether start_rows gives the start of a step (by default not: the caller takes it by
+    /// parts, start_part or the calls it stands for).
+    virtual bool starts_by_rows() const { return false; }
+    /// start_part by rows: at the rows of plan `plan`, once set_part has run for every part,
+    /// f += f(x, v) + (∂f/∂x) dx1, df2 += (∂f/∂x) dx2 and blocks[i] += cx (∂f/∂x)_ii (the field
+    /// has no velocity term where it has rows), the other entries untouched.
+    virtual void start_rows(const Eigen::VectorXd& /*dx1*/, Eigen::VectorXd& /*f*/,
+                            const Eigen::VectorXd& /*dx2*/, Eigen::VectorXd& /*df2*/, double /*cx*/,
+                            std::vector<Eigen::Matrix3d>& /*blocks*/, int /*plan*/) const {}
   };
   /// A tangent at the state in x and v, which must outlive it. By default it multiplies with
   /// add_dfdx_product_part at each product, which suits a field whose product costs little beside
