@@ -5,6 +5,7 @@
 // the groups at its nodes and then each of its nodes' sum over its elements: no scatter.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <utility>
@@ -28,6 +29,10 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
 
   // Gradients and volumes of this part's groups; the lanes a group does not fill keep scale 0.
   void set_part(int part, int parts) override {
+    // Read only after the caller's barrier that follows every part's set_part.
+    if (part == 0)
+      for (RowPlan& p : plans_)
+        p.rows_gathered = false;
     for_each_group(part, parts, [&](int group) { set_group(group); });
   }
 
@@ -118,6 +123,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
       }
       p.s.assign(scale_.size(), 0.0);
       p.s2.assign(scale_.size(), 0.0);
+      p.g_rows.assign(3 * p.lane.size(), 0.0);
     }
     return true;
   }
@@ -132,17 +138,30 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
         p.s[lane] = -scale_[lane] / 36.0 * dot[l];
       }
     }
-    for (std::size_t r = 0; r < p.rows.size(); ++r) {
-      double f[3] = {0.0, 0.0, 0.0};
-      for (int i = p.row_start[r]; i < p.row_start[r + 1]; ++i) {
-        const double s = p.s[static_cast<std::size_t>(p.lane[i])];
-        const double* g = g_.data() + p.g_at[i];
-        f[0] += s * g[0];
-        f[1] += s * g[L];
-        f[2] += s * g[2 * L];
+    const auto sum_rows = [&](auto g_of) {
+      for (std::size_t r = 0; r < p.rows.size(); ++r) {
+        double f[3] = {0.0, 0.0, 0.0};
+        for (int i = p.row_start[r]; i < p.row_start[r + 1]; ++i) {
+          const double s = p.s[static_cast<std::size_t>(p.lane[i])];
+          const auto [gx, gy, gz] = g_of(i);
+          f[0] += s * gx;
+          f[1] += s * gy;
+          f[2] += s * gz;
+        }
+        for (int c = 0; c < 3; ++c)
+          df[3 * p.rows[r] + c] += f[c];
       }
-      for (int c = 0; c < 3; ++c)
-        df[3 * p.rows[r] + c] += f[c];
+    };
+    if (p.rows_gathered) {
+      sum_rows([&](int i) {
+        const double* g = p.g_rows.data() + 3 * static_cast<std::size_t>(i);
+        return std::array<double, 3>{g[0], g[1], g[2]};
+      });
+    } else {
+      sum_rows([&](int i) {
+        const double* g = g_.data() + p.g_at[i];
+        return std::array<double, 3>{g[0], g[L], g[2 * L]};
+      });
     }
   }
 
@@ -169,6 +188,10 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
         const std::size_t lane = static_cast<std::size_t>(p.lane[i]);
         const double* g = g_.data() + p.g_at[i];
         const double gx = g[0], gy = g[L], gz = g[2 * L];
+        double* row_g = p.g_rows.data() + 3 * static_cast<std::size_t>(i);
+        row_g[0] = gx;
+        row_g[1] = gy;
+        row_g[2] = gz;
         const double s1 = p.s[lane], s2 = p.s2[lane], k = c * scale_[lane];
         f1[0] += s1 * gx;
         f1[1] += s1 * gy;
@@ -200,6 +223,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
       m[5] -= e[5];
       m[7] -= e[5];
     }
+    p.rows_gathered = true;
   }
 
   // The field has no velocity term: cv does not enter.
@@ -319,6 +343,9 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     std::vector<int> groups;         // the groups with an element at a row
     mutable std::vector<double> s;   // per group lane: −κ/|V⁰| (g·dx)/36 at `groups`
     mutable std::vector<double> s2;  // per group lane: start_rows's second factor
+    // Per incidence, its g (x y z) in row order, gathered by start_rows for the step's products.
+    mutable std::vector<double> g_rows;
+    mutable bool rows_gathered = false;
   };
 
   const VolumeForceField* field_;

@@ -212,6 +212,8 @@ struct CgVectors {
   Real *dv[3], *r[3], *p[3], *y[3], *inverse_block[6];
   Real* b[3] = {nullptr, nullptr,
                 nullptr};  ///< the right-hand side, kept only where fields add to it
+  /// The diagonal blocks before inversion, kept only where fields add to them.
+  Real* block[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
 };
 
 }  // namespace msfem::massspring::detail

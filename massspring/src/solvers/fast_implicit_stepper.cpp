@@ -220,6 +220,10 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       rhs_[c].assign(fields_.empty() ? 0 : lanes, Real(0));
       cg_.b[c] = fields_.empty() ? nullptr : rhs_[c].data();
     }
+    for (int e = 0; e < 6; ++e) {
+      block_[e].assign(fields_.empty() ? 0 : lanes, Real(0));
+      cg_.block[e] = fields_.empty() ? nullptr : block_[e].data();
+    }
   }
 
   // r·u, r·r and b·b over the lanes of block `block`, once the fields have changed r and u.
@@ -276,6 +280,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   Real* direction_pointers_[3];
   Real* direction_product_pointers_[3];
   detail::AlignedVector<Real> inverse_block_[6];
+  detail::AlignedVector<Real> block_[6];  // uninverted, where fields add to the blocks
   detail::CgVectors<Real> cg_;
   std::vector<int> member_block_;      // the members' first blocks, then the number of blocks
   std::vector<double> block_sums_[2];  // per block of chunks: three partial sums

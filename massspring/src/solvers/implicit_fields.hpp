@@ -322,8 +322,7 @@ class ImplicitFields {
       cg.r[c][n.lane] += static_cast<Real>(h * (b_field[c] + a_field[c]));
       r[c] = cg.r[c][n.lane];
     }
-    const Eigen::Matrix3d block = read_block(cg, n.lane).inverse() - field_block;
-    const Eigen::Matrix3d inverse = block.inverse();
+    const Eigen::Matrix3d inverse = (read_block(cg.block, n.lane) - field_block).inverse();
     write_block(cg, n.lane, inverse);
     const Eigen::Vector3d u = inverse * r;
     for (int c = 0; c < 3; ++c) {
@@ -331,8 +330,8 @@ class ImplicitFields {
       u_records[kDirection * n.id + c] = static_cast<Real>(u[c]);
     }
   }
-  static Eigen::Matrix3d read_block(const CgVectors<Real>& cg, int lane) {
-    const auto q = [&](int e) { return static_cast<double>(cg.inverse_block[e][lane]); };
+  static Eigen::Matrix3d read_block(Real* const (&block)[6], int lane) {
+    const auto q = [&](int e) { return static_cast<double>(block[e][lane]); };
     Eigen::Matrix3d m;
     m << q(0), q(3), q(4), q(3), q(1), q(5), q(4), q(5), q(2);
     return m;
