@@ -245,6 +245,9 @@ TEST(CaseSettings, EveryIntegratorIsTheOneTimed) {
     EXPECT_GT(t.steps_per_second, 0.0);
     if (kind == massspring::IntegratorKind::implicit_euler) {
       EXPECT_EQ(t.stable_dt_s, 1e-3);
+      EXPECT_EQ(t.dt_s, t.stable_dt_s);  // timed at the step its real-time factor is for
+    } else {
+      EXPECT_EQ(t.dt_s, 0.5 * t.stable_dt_s) << name_of(kind);
     }
     // On the code a simulator runs: the fast kernels, explicit or implicit.
     EXPECT_EQ(t.stepper, kind == massspring::IntegratorKind::implicit_euler ? "fast_implicit"

@@ -135,7 +135,7 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
                     int threads = 0);
 
 /// The step time_variant steps the case's integrator with: timing/dt, or half the stable step
-/// (implicit Euler: half of a 1 kHz loop's).
+/// (implicit Euler: a 1 kHz loop's, the step its real-time factor is for).
 double timed_dt(const massspring::MassSpringModel& model, const cases::TimingParameters& timing);
 
 }  // namespace msfem::compare
