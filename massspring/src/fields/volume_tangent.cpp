@@ -2,7 +2,9 @@
 // linearisation point, kept in the field's lane groups (volume_batches.hpp) so that every product
 // of a solve is a vector pass over a group's lanes — a gather, a dot product per lane, a scatter —
 // instead of one element at a time. With rows planned, a thread's product is the dot products of
-// the groups at its nodes and then each of its nodes' sum over its elements: no scatter.
+// the groups at its nodes and then each of its nodes' sum over its elements: no scatter. The start
+// of a backward-Euler step goes the same way (start_rows), and gathers each row's gradients into
+// row order for the step's products.
 
 #include <algorithm>
 #include <array>

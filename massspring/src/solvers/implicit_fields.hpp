@@ -138,9 +138,8 @@ class ImplicitFields {
   // After the pass's barrier, this member's part of the fields' right-hand side, b_F / h =
   // f_F + K_F (h v), of -A_F Δv / h = K_F (h Δv) + D_F Δv and of the diagonal blocks of
   // -A_F = h D_F + h² K_F. The parts are zero at every field node here: start_apply clears
-  // what it reads.
-  // Where every tangent starts by rows, only their own parts (set_part): start_apply takes the
-  // rest by rows.
+  // what it reads. Where every tangent starts by rows, only the tangents' own parts (set_part):
+  // start_apply takes the rest by rows.
   void start_part(int member, int members, double h) {
     if (start_rows_) {
       for (const auto& tangent : tangents_)
@@ -164,11 +163,10 @@ class ImplicitFields {
   }
 
   // After the next barrier, at this member's field lanes: b += b_F, r += b_F - A_F Δv, the
-  // preconditioner's block B += A_F (re-inverted), u = B⁻¹ r into cg.p and `u_records`. Where
-  // they start by rows, the tangents give b_F, A_F Δv and the blocks at the rows of plan `plan`;
-  // else this
-  // clears the parts it reads at this member's nodes, so that no member zeroes a whole part each
-  // step.
+  // preconditioner's block B += A_F (inverted), u = B⁻¹ r into cg.p and `u_records`. Where they
+  // start by rows, the tangents give b_F, A_F Δv and the blocks at the rows of plan `plan`; else
+  // this sums the members' parts and clears them at this member's nodes, so that no member zeroes
+  // a whole part each step.
   void start_apply(int b0, int b1, int members, int plan, const CgVectors<Real>& cg,
                    Real* u_records, double h) {
     if (start_rows_) {
