@@ -62,8 +62,8 @@ JacobianErrors check_force_jacobians(const ForceModel& model, const Eigen::Vecto
 
 double FieldCallErrors::worst() const {
   return std::max({force_parts, product_parts, diagonal_blocks, tangent_product,
-                   tangent_pair_product, tangent_blocks, tangent_force, tangent_rows,
-                   outside_nodes});
+                   tangent_pair_product, tangent_blocks, tangent_force, tangent_rows, tangent_start,
+                   tangent_start_rows, outside_nodes});
 }
 
 FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd& x,
@@ -125,14 +125,49 @@ FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd
     worse(e.tangent_pair_product, std::max(relative(product, tdf1), relative(product2, tdf2)));
     worse(e.tangent_blocks, relative(blocks_expected, stacked(tangent_blocks)));
     if (gives_force) worse(e.tangent_force, relative(force, tf));
-    for (std::size_t plan = 0; rows && plan < plans.size(); ++plan) {
-      // A plan's rows are the product's at its nodes; the other entries keep what they held.
+    // A plan's rows are the product's at its nodes; the other entries keep what they held.
+    const auto check_rows = [&](int plan) {
       Eigen::VectorXd expected = Eigen::VectorXd::Constant(n, 7.0), got = expected;
-      for (int i : plans[plan])
+      for (int i : plans[std::size_t(plan)])
         expected.segment<3>(3 * i) += product.segment<3>(3 * i);
-      tangent->add_product_rows(dx, got, static_cast<int>(plan));
+      tangent->add_product_rows(dx, got, plan);
       worse(e.tangent_rows, (got - expected).norm() / product.norm());
+    };
+    for (int plan = 0; rows && plan < int(plans.size()); ++plan)
+      check_rows(plan);
+    // The start of a step by rows: force + K dx, K dx2 and the blocks at the plan's rows, the
+    // other entries kept; the products after it (which may read what it gathered) again.
+    if (rows && tangent->starts_by_rows()) {
+      for (int plan = 0; plan < int(plans.size()); ++plan) {
+        Eigen::VectorXd f_expected = Eigen::VectorXd::Constant(n, 7.0), f_got = f_expected;
+        Eigen::VectorXd df2_expected = f_expected, df2_got = f_expected;
+        std::vector<Eigen::Matrix3d> blocks_got(nodes, Eigen::Matrix3d::Identity());
+        Eigen::MatrixXd blocks_want = stacked(blocks_got);
+        for (int i : plans[std::size_t(plan)]) {
+          f_expected.segment<3>(3 * i) += force.segment<3>(3 * i) + product.segment<3>(3 * i);
+          df2_expected.segment<3>(3 * i) += product2.segment<3>(3 * i);
+          blocks_want.middleRows<3>(3 * i) += blocks_expected.middleRows<3>(3 * i);
+        }
+        tangent->start_rows(dx, f_got, dx2, df2_got, cx, blocks_got, plan);
+        worse(e.tangent_start_rows,
+              std::max({(f_got - f_expected).norm() / (force + product).norm(),
+                        (df2_got - df2_expected).norm() / product2.norm(),
+                        relative(blocks_want, stacked(blocks_got))}));
+        check_rows(plan);
+      }
     }
+    // The start of a step in one call, on a tangent of its own (start_part sets it).
+    const auto starter = field.tangent(x, v, definite);
+    starter->plan_rows(plans);
+    Eigen::VectorXd sf = Eigen::VectorXd::Zero(n), sdf2 = sf;
+    std::vector<Eigen::Matrix3d> start_blocks(nodes, Eigen::Matrix3d::Zero());
+    bool started = true;
+    for (int part = 0; part < parts; ++part)
+      started =
+          starter->start_part(dx, sf, dx2, sdf2, cx, cv, start_blocks, part, parts) && started;
+    if (started)
+      worse(e.tangent_start, std::max({relative(force + product, sf), relative(product2, sdf2),
+                                       relative(blocks_expected, stacked(start_blocks))}));
   }
   std::vector<char> on(nodes, 0);
   for (int i : field.nodes())

@@ -39,7 +39,9 @@ struct FieldCallErrors {
   double tangent_blocks = 0.0;
   double tangent_force = 0.0;
   double tangent_rows = 0.0;   ///< where the tangent plans rows (ForceField::Tangent::plan_rows)
-  double outside_nodes = 0.0;  ///< |force and product off the field's nodes| / |force|
+  double tangent_start = 0.0;  ///< where the tangent takes a step's start in one call (start_part)
+  double tangent_start_rows = 0.0;  ///< where it takes it by rows (starts_by_rows, start_rows)
+  double outside_nodes = 0.0;       ///< |force and product off the field's nodes| / |force|
   double worst() const;
 };
 FieldCallErrors check_field_calls(const ForceField& field, const Eigen::VectorXd& x,

@@ -204,7 +204,9 @@ TEST(VolumeForceField, MixedShapesInPartialLaneGroupsMatchFiniteDifferences) {
     volume.add_force_part(x, Eigen::VectorXd::Zero(x.size()), parts, part, 3);
   EXPECT_LE((parts - f).norm(), 1e-13 * f.norm());
   const auto calls = testing::check_field_calls(volume, x, Eigen::VectorXd::Zero(x.size()));
-  EXPECT_LT(calls.worst(), 1e-12) << "rows " << calls.tangent_rows;
+  EXPECT_LT(calls.worst(), 1e-12) << "rows " << calls.tangent_rows << ", start "
+                                  << calls.tangent_start << ", start rows "
+                                  << calls.tangent_start_rows;
 }
 
 TEST(VolumeForceField, PrismsFillTheShellsBetweenTheTiers) {
