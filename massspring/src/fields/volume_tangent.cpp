@@ -69,8 +69,15 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                              const Eigen::VectorXd& dx2, Eigen::VectorXd& df2, int part,
                              int parts) const override {
     for_each_group(part, parts, [&](int group) {
-      add_group_product(group, dx1, df1);
-      add_group_product(group, dx2, df2);
+      const double* g = gradient(group);
+      double s1[L], s2[L];
+      detail::group_dot_pair(*batches_, group, g, dx1.data(), dx2.data(), s1, s2);
+      for (int l = 0; l < L; ++l) {
+        const double scale = -scale_[static_cast<std::size_t>(group) * L + l] / 36.0;
+        s1[l] *= scale;
+        s2[l] *= scale;
+      }
+      detail::scatter_group_pair(*batches_, group, g, s1, df1.data(), s2, df2.data());
     });
   }
 

@@ -305,9 +305,10 @@ class ImplicitFields {
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(rows_ ? dofs : 0);
     plan_u_.assign(static_cast<std::size_t>(team_) + 1, zero);
     plan_y_.assign(static_cast<std::size_t>(team_) + 1, zero);
-    plan_blocks_.assign(static_cast<std::size_t>(team_) + 1,
-                        std::vector<Eigen::Matrix3d>(rows_ ? static_cast<std::size_t>(dofs / 3) : 0,
-                                                     Eigen::Matrix3d::Zero()));
+    plan_blocks_.assign(
+        static_cast<std::size_t>(team_) + 1,
+        std::vector<Eigen::Matrix3d>(start_rows_ ? static_cast<std::size_t>(dofs / 3) : 0,
+                                     Eigen::Matrix3d::Zero()));
   }
   // At node n's lane, from the fields' b_F / h, -A_F Δv / h and diagonal block of -A_F.
   static void apply_start(const Node& n, const Eigen::Ref<const Eigen::Vector3d>& b_field,
