@@ -87,9 +87,11 @@ struct NodeGatherLayout {
   Real uniform_c = 0;  // every spring's c when spring_damping == uniform
   AlignedVector<Real> mass, inverse_mass, damping, anchor, load[3];  // per lane (idle: mass 1)
   std::vector<int> block_begin;  // chunk ranges handed out to the threads
-  // Relative records (soa_layout.hpp): each node's frame position, kDirection reals per record
-  // (the idle and far records at the origin), gathered beside the records; empty otherwise.
-  AlignedVector<Real> frame;
+  // Relative records (soa_layout.hpp): per slot, the frame's edge X_j - X_i from the lane's node
+  // to its neighbour (the idle and far records' frame at the origin), read in slot order beside
+  // k and k l0 so that a spring's rest geometry costs three plain loads per W slots instead of a
+  // second gather and transpose; empty otherwise.
+  AlignedVector<Real> rest_edge[3];
 
   explicit NodeGatherLayout(const SoaLayout<Real>& soa) {
     idle_record = soa.num_nodes;
@@ -139,13 +141,10 @@ struct NodeGatherLayout {
       l.assign(lane_node.size(), Real(0));
     load_parameters(soa);
     partition();
-    if (soa.relative) {
-      frame.assign(static_cast<std::size_t>(kDirection) * (soa.num_nodes + 2), Real(0));
-      for (int i = 0; i < soa.num_nodes; ++i)
-        for (int d = 0; d < 3; ++d)
-          frame[kDirection * i + d] = static_cast<Real>(soa.frame_at(d, i));
-    }
+    if (soa.relative) load_rest_edges(soa);
   }
+
+  bool relative() const { return !rest_edge[0].empty(); }
 
   static int record_offset(int node) { return node * kRecord * static_cast<int>(sizeof(Real)); }
 
@@ -177,6 +176,22 @@ struct NodeGatherLayout {
       for (int d = 0; d < 3; ++d)
         load[d][lane] = soa.load[d][i];
     }
+  }
+
+  // The frame is float-representable, so X_j - X_i in double rounds once: the float difference.
+  void load_rest_edges(const SoaLayout<Real>& soa) {
+    auto frame = [&](int d, int node) { return node < soa.num_nodes ? soa.frame_at(d, node) : 0.0; };
+    for (int d = 0; d < 3; ++d)
+      rest_edge[d].assign(chunk_slot.back(), Real(0));
+    for (int chunk = 0; chunk < num_chunks; ++chunk)
+      for (int lane = 0; lane < W; ++lane) {
+        const int i = lane_node[chunk * W + lane];
+        for (int slot = chunk_slot[chunk] + lane; slot < chunk_slot[chunk + 1]; slot += W) {
+          const int j = neighbour[slot] / record_offset(1);
+          for (int d = 0; d < 3; ++d)
+            rest_edge[d][slot] = static_cast<Real>(frame(d, j) - frame(d, i));
+        }
+      }
   }
 
   // Blocks of consecutive chunks, about kBlockSlots slots each, handed out to the threads one at a

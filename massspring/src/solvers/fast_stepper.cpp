@@ -185,13 +185,13 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   int last_step_threads() const override { return threads_.last(); }
   std::size_t streamed_bytes_per_step() const override {
     const std::size_t lanes = gather_.lane_offset.size(), slots = gather_.neighbour.size();
+    // A relative layout reads each slot's rest edge too.
     const std::size_t per_slot =
         sizeof(int) +
-        (gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) * sizeof(Real);
-    // A relative layout reads each lane's frame position too (its neighbours' are gathered from
-    // cache, as their records are).
-    const std::size_t own_frame = gather_.frame.empty() ? 0 : detail::kDirection * sizeof(Real);
-    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real) + own_frame) +
+        ((gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) +
+         (gather_.relative() ? 3 : 0)) *
+            sizeof(Real);
+    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real)) +
                              slots * per_slot + gather_.chunk_slot.size() * sizeof(int);
     const std::size_t buffer = records_[0].size() * sizeof(Real);
     // RK4's record buffers: the first stage reads `in` and writes out and acc (3), the middle two
