@@ -288,6 +288,7 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
         1, options);
     result.implicit_steps_per_second = result.implicit_spread.median;
     result.implicit_mean_cg_iterations = static_cast<double>(iterations) / std::max(steps, 1L);
+    result.implicit_single_precision_terms = implicit.single_precision_terms();
   }
   if (options.compare_precision)
     result.float_vs_double =

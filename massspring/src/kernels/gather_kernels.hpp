@@ -49,6 +49,13 @@ struct PortableLanes {
     for (int l = 0; l < N; ++l)
       p[l] = a.v[l];
   }
+  static MSFEM_INLINE V load_single(const float* p) {
+    return map([&](int l) { return static_cast<R>(p[l]); });
+  }
+  static MSFEM_INLINE void store_single(float* p, V a) {
+    for (int l = 0; l < N; ++l)
+      p[l] = static_cast<float>(a.v[l]);
+  }
   static MSFEM_INLINE V set1(R a) {
     return map([&](int) { return a; });
   }
@@ -218,7 +225,9 @@ class Kernels {
   double product(const NodeGatherLayout<Real, W>& g, const ImplicitCoefficients<Real>& sys,
                  const Real* p_records, Real* const (&p)[3], Real* const (&y)[3], int begin,
                  int end) const {
-    MSFEM_DISPATCH(product_chunks, g, sys, p_records, p, y, begin, end);
+    if constexpr (std::is_same_v<Real, double>)
+      if (sys.single) return product_for<true>(g, sys, p_records, p, y, begin, end);
+    return product_for<false>(g, sys, p_records, p, y, begin, end);
   }
   void cg_iterate(const NodeGatherLayout<Real, W>& g, const CgVectors<Real>& cg,
                   Real* const (&direction)[3], Real* const (&direction_product)[3], Real* u_records,
@@ -302,22 +311,52 @@ class Kernels {
                            const Real* dv_records, ImplicitCoefficients<Real>& sys,
                            const CgVectors<Real>& cg, Real* p_records, int begin, int end, Real h,
                            double (&sums)[3]) const {
+    if constexpr (std::is_same_v<Real, double>)
+      if (sys.single)
+        return linearise_start_terms<Damped, true>(g, records, dv_records, sys, cg, p_records,
+                                                   begin, end, h, sums);
+    return linearise_start_terms<Damped, false>(g, records, dv_records, sys, cg, p_records, begin,
+                                                end, h, sums);
+  }
+  template <SpringDamping Damped, bool Single>
+  void linearise_start_terms(const NodeGatherLayout<Real, W>& g, const Real* records,
+                             const Real* dv_records, ImplicitCoefficients<Real>& sys,
+                             const CgVectors<Real>& cg, Real* p_records, int begin, int end, Real h,
+                             double (&sums)[3]) const {
 #if MSFEM_HAVE_X86_DISPATCH
     if constexpr (W == 16) {
-      return linearise_start_chunks_avx512<Avx512Float, Damped>(g, records, dv_records, sys, cg,
-                                                                p_records, begin, end, h, sums);
+      return linearise_start_chunks_avx512<Avx512Float, Damped, Single>(
+          g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
     } else if constexpr (W == 32 / sizeof(Real)) {
       if constexpr (std::is_same_v<Real, double>)
         if (avx512_)
-          return linearise_start_chunks_avx512<Avx512VlDouble, Damped>(
+          return linearise_start_chunks_avx512<Avx512VlDouble, Damped, Single>(
               g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
       if (avx2_)
-        return linearise_start_chunks_avx2<Avx2<Real>, Damped>(g, records, dv_records, sys, cg,
-                                                               p_records, begin, end, h, sums);
+        return linearise_start_chunks_avx2<Avx2<Real>, Damped, Single>(
+            g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
     }
 #endif
-    return linearise_start_chunks_portable<PortableLanes<Real, W>, Damped>(
+    return linearise_start_chunks_portable<PortableLanes<Real, W>, Damped, Single>(
         g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
+  }
+  template <bool Single>
+  double product_for(const NodeGatherLayout<Real, W>& g, const ImplicitCoefficients<Real>& sys,
+                     const Real* p_records, Real* const (&p)[3], Real* const (&y)[3], int begin,
+                     int end) const {
+#if MSFEM_HAVE_X86_DISPATCH
+    if constexpr (W == 16) {
+      return product_chunks_avx512<Avx512Float, Single>(g, sys, p_records, p, y, begin, end);
+    } else if constexpr (W == 32 / sizeof(Real)) {
+      if constexpr (std::is_same_v<Real, double>)
+        if (avx512_)
+          return product_chunks_avx512<Avx512VlDouble, Single>(g, sys, p_records, p, y, begin, end);
+      if (avx2_)
+        return product_chunks_avx2<Avx2<Real>, Single>(g, sys, p_records, p, y, begin, end);
+    }
+#endif
+    return product_chunks_portable<PortableLanes<Real, W>, Single>(g, sys, p_records, p, y, begin,
+                                                                   end);
   }
 
   bool avx2_, avx512_;

@@ -180,7 +180,9 @@ struct NodeGatherLayout {
 
   // The frame is float-representable, so X_j - X_i in double rounds once: the float difference.
   void load_rest_edges(const SoaLayout<Real>& soa) {
-    auto frame = [&](int d, int node) { return node < soa.num_nodes ? soa.frame_at(d, node) : 0.0; };
+    auto frame = [&](int d, int node) {
+      return node < soa.num_nodes ? soa.frame_at(d, node) : 0.0;
+    };
     for (int d = 0; d < 3; ++d)
       rest_edge[d].assign(chunk_slot.back(), Real(0));
     for (int chunk = 0; chunk < num_chunks; ++chunk)
@@ -209,13 +211,19 @@ struct NodeGatherLayout {
 // The linearised backward-Euler system of one step in slot and lane order (fast implicit stepper):
 // per slot y += α q + (e·q) e for q = p_j - p_i, stored per group of W slots as W α, then W of each
 // component of e (one stream for the product to read); per lane the diagonal term m + h c + h² k_a.
+// A double solve may keep the slot terms in float (`single`, in single_terms): every CG product
+// streams them, and from the L3 cache that stream bounds the product.
 template <class Real>
 struct ImplicitCoefficients {
-  AlignedVector<Real> slot_terms;  // 4 per slot
-  AlignedVector<Real> own;         // per lane
+  AlignedVector<Real> slot_terms;     // 4 per slot, unless single
+  AlignedVector<float> single_terms;  // 4 per slot where single
+  AlignedVector<Real> own;            // per lane
+  bool single = false;
 
-  void resize(std::size_t slots, std::size_t lanes) {
-    slot_terms.assign(4 * slots, Real(0));
+  void resize(std::size_t slots, std::size_t lanes, bool single_terms_wanted = false) {
+    single = single_terms_wanted && !std::is_same_v<Real, float>;
+    slot_terms.assign(single ? 0 : 4 * slots, Real(0));
+    single_terms.assign(single ? 4 * slots : 0, 0.0f);
     own.assign(lanes, Real(1));
   }
 };

@@ -25,6 +25,7 @@ class FastImplicitStepper::Implementation {
   virtual void step(double h) = 0;
   virtual int last_iterations() const = 0;
   virtual int last_threads() const = 0;
+  virtual bool single_precision_terms() const = 0;
   virtual int num_nodes() const = 0;
   virtual int num_springs() const = 0;
 };
@@ -48,7 +49,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         dv_records_(detail::kDirection * (soa_.num_nodes + 2)),
         fields_(soa_, gather_, team_.size()) {
     const std::size_t lanes = gather_.lane_node.size();
-    system_.resize(gather_.chunk_slot.back(), lanes);
+    system_.resize(gather_.chunk_slot.back(), lanes,
+                   options.single_precision_terms && options.cg_tolerance >= kSingleTermsTolerance);
     for (int c = 0; c < 3; ++c)
       for (auto* v :
            {&dv_[c], &residual_[c], &u_[c], &w_[c], &direction_[c], &direction_product_[c]}) {
@@ -97,6 +99,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   }
   int last_iterations() const override { return last_iterations_; }
   int last_threads() const override { return threads_.last(); }
+  bool single_precision_terms() const override { return system_.single; }
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
 
@@ -315,6 +318,9 @@ int FastImplicitStepper::last_cg_iterations() const {
 }
 int FastImplicitStepper::last_step_threads() const {
   return impl_->last_threads();
+}
+bool FastImplicitStepper::single_precision_terms() const {
+  return impl_->single_precision_terms();
 }
 int FastImplicitStepper::num_nodes() const {
   return impl_->num_nodes();

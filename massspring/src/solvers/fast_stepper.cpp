@@ -187,12 +187,11 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
     const std::size_t lanes = gather_.lane_offset.size(), slots = gather_.neighbour.size();
     // A relative layout reads each slot's rest edge too.
     const std::size_t per_slot =
-        sizeof(int) +
-        ((gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) +
-         (gather_.relative() ? 3 : 0)) *
-            sizeof(Real);
-    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real)) +
-                             slots * per_slot + gather_.chunk_slot.size() * sizeof(int);
+        sizeof(int) + ((gather_.spring_damping == detail::SpringDamping::per_spring ? 3 : 2) +
+                       (gather_.relative() ? 3 : 0)) *
+                          sizeof(Real);
+    const std::size_t pass = lanes * (sizeof(int) + 6 * sizeof(Real)) + slots * per_slot +
+                             gather_.chunk_slot.size() * sizeof(int);
     const std::size_t buffer = records_[0].size() * sizeof(Real);
     // RK4's record buffers: the first stage reads `in` and writes out and acc (3), the middle two
     // read in, base and acc and write out and acc (5 each), the last reads in and acc and writes

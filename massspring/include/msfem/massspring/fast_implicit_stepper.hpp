@@ -8,6 +8,10 @@
 
 namespace msfem::massspring {
 
+/// The tightest CG tolerance at which a double solve keeps its springs' coefficients in float
+/// (FastImplicitOptions::single_precision_terms).
+constexpr double kSingleTermsTolerance = 1e-6;
+
 struct FastImplicitOptions {
   int threads = 2;
   bool reorder_nodes = true;
@@ -26,6 +30,13 @@ struct FastImplicitOptions {
   /// depend on it: sums are taken per block of nodes in a fixed order, for any number of threads
   /// (a force field's parts are summed per thread, so with one only to rounding).
   bool adaptive_threads = true;
+  /// In double precision, keep the springs' per-step system coefficients (α and e below: what
+  /// every CG product streams, 32 bytes a spring end) in float where the solve is loose,
+  /// cg_tolerance >= kSingleTermsTolerance: the products stream half the bytes. The system they
+  /// apply is then the double one rounded to float per coefficient (relative 6e-8, symmetric as
+  /// before), far inside such a tolerance; state, right-hand side, preconditioner and CG vectors
+  /// stay double. Tighter tolerances keep every coefficient double.
+  bool single_precision_terms = true;
 };
 
 /// Backward Euler on the same node-centric layout, kernels and thread team as FastExplicitStepper
@@ -59,6 +70,9 @@ class FastImplicitStepper : public Stepper {
   int last_cg_iterations() const;
   /// Threads the last step ran on (1 while adaptive_threads found one faster).
   int last_step_threads() const;
+  /// Whether this double solve keeps its springs' coefficients in float
+  /// (FastImplicitOptions::single_precision_terms and a loose enough cg_tolerance).
+  bool single_precision_terms() const;
   int num_nodes() const;
   int num_springs() const;
 

@@ -82,6 +82,7 @@ struct SteppingBenchmarkResult {
   double naive_steps_per_second = 0.0;     ///< NaiveAosStepper, median (0 when not run)
   double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
+  bool implicit_single_precision_terms = false;  ///< FastImplicitStepper::single_precision_terms
   RateSpread explicit_spread, naive_spread, implicit_spread;
   RateSpread explicit_euler_spread, rk4_spread;  ///< at explicit_dt / 100
   std::size_t explicit_bytes_per_step = 0;
