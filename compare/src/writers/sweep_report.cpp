@@ -201,8 +201,8 @@ std::string sweep_answer(const std::vector<SweepPoint>& points, std::optional<do
     out << answer_row(budget, cheapest);
   }
   out << "\nA loop of rate f keeps real time when each tick's ceil(1 / (f dt)) steps, at the step "
-         "dt the sweep timed (half the measured stable step), take at most 1/f s on this "
-         "machine. "
+         "dt the sweep timed (half the measured stable step; implicit Euler at 1 ms, a haptic "
+         "loop's own step), take at most 1/f s on this machine. "
       << (max_error ? "" : "`--max-error E` adds the cheapest configuration within rel L2 E. ")
       << "Configurations the reference resolves are preferred. ‡: within 3x of the reference's "
          "own error, so not resolved by this reference.\n\n";
