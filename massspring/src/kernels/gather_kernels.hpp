@@ -42,19 +42,15 @@ struct PortableLanes {
       out.v[l] = f(l);
     return out;
   }
-  static MSFEM_INLINE V load(const R* p) {
-    return map([&](int l) { return p[l]; });
-  }
-  static MSFEM_INLINE void store(R* p, V a) {
-    for (int l = 0; l < N; ++l)
-      p[l] = a.v[l];
-  }
-  static MSFEM_INLINE V load_single(const float* p) {
+  // From and to R, or float (a double solve's float coefficients).
+  template <class T>
+  static MSFEM_INLINE V load(const T* p) {
     return map([&](int l) { return static_cast<R>(p[l]); });
   }
-  static MSFEM_INLINE void store_single(float* p, V a) {
+  template <class T>
+  static MSFEM_INLINE void store(T* p, V a) {
     for (int l = 0; l < N; ++l)
-      p[l] = static_cast<float>(a.v[l]);
+      p[l] = static_cast<T>(a.v[l]);
   }
   static MSFEM_INLINE V set1(R a) {
     return map([&](int) { return a; });

@@ -24,8 +24,6 @@ struct Avx2Float {
   static constexpr int W = 8;
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V load(const float* p) { return _mm256_loadu_ps(p); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE void store(float* p, V a) { _mm256_storeu_ps(p, a); }
-  MSFEM_TARGET_AVX2 static MSFEM_INLINE V load_single(const float* p) { return load(p); }
-  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store_single(float* p, V a) { store(p, a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V max(V a, V b) { return _mm256_max_ps(a, b); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V sqrt(V a) { return _mm256_sqrt_ps(a); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V div(V a, V b) { return _mm256_div_ps(a, b); }
@@ -118,10 +116,11 @@ struct Avx2Double {
   static constexpr int W = 4;
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V load(const double* p) { return _mm256_loadu_pd(p); }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE void store(double* p, V a) { _mm256_storeu_pd(p, a); }
-  MSFEM_TARGET_AVX2 static MSFEM_INLINE V load_single(const float* p) {
+  // A double solve's float coefficients.
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE V load(const float* p) {
     return _mm256_cvtps_pd(_mm_loadu_ps(p));
   }
-  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store_single(float* p, V a) {
+  MSFEM_TARGET_AVX2 static MSFEM_INLINE void store(float* p, V a) {
     _mm_storeu_ps(p, _mm256_cvtpd_ps(a));
   }
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V max(V a, V b) { return _mm256_max_pd(a, b); }
@@ -224,8 +223,6 @@ struct Avx512Float {
   static constexpr int W = 16;
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V load(const float* p) { return _mm512_loadu_ps(p); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void store(float* p, V a) { _mm512_storeu_ps(p, a); }
-  MSFEM_TARGET_AVX512 static MSFEM_INLINE V load_single(const float* p) { return load(p); }
-  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store_single(float* p, V a) { store(p, a); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V max(V a, V b) { return _mm512_max_ps(a, b); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V sqrt(V a) { return _mm512_sqrt_ps(a); }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V div(V a, V b) { return _mm512_div_ps(a, b); }

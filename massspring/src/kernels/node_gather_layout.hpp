@@ -220,6 +220,21 @@ struct ImplicitCoefficients {
   AlignedVector<Real> own;            // per lane
   bool single = false;
 
+  template <bool Single>
+  auto* terms() {
+    if constexpr (Single)
+      return single_terms.data();
+    else
+      return slot_terms.data();
+  }
+  template <bool Single>
+  const auto* terms() const {
+    if constexpr (Single)
+      return single_terms.data();
+    else
+      return slot_terms.data();
+  }
+
   void resize(std::size_t slots, std::size_t lanes, bool single_terms_wanted = false) {
     single = single_terms_wanted && !std::is_same_v<Real, float>;
     slot_terms.assign(single ? 0 : 4 * slots, Real(0));
