@@ -137,6 +137,15 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     return true;
   }
 
+  // Per element at each of its nodes: its share of the element's dot product and of the row's
+  // sum. A step of the pressed tet_edges sphere spends about twice as long per such incidence as
+  // per spring slot (18.5 against 8.9 ns, one thread, perf).
+  void add_row_work(std::vector<double>& work) const override {
+    constexpr double slots_per_incidence = 2.0;
+    for (int node_offset : field_->element_node_offset_)
+      work[static_cast<std::size_t>(node_offset / 3)] += slots_per_incidence;
+  }
+
   void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
     for (int group : p.groups) {

@@ -198,11 +198,12 @@ struct NodeGatherLayout {
 
   // Blocks of consecutive chunks, about kBlockSlots slots each, handed out to the threads one at a
   // time (see fast_stepper.cpp): small enough that a thread the OS pre-empts holds up the others
-  // for one block only, large enough that taking one costs nothing.
-  void partition() {
+  // for one block only, large enough that taking one costs nothing. The implicit stepper, which
+  // shares them out once, asks for smaller ones on a small model.
+  void partition(int block_slots = kBlockSlots) {
     block_begin.assign(1, 0);
     for (int chunk = 0; chunk < num_chunks; ++chunk)
-      if (chunk_slot[chunk + 1] - chunk_slot[block_begin.back()] >= kBlockSlots)
+      if (chunk_slot[chunk + 1] - chunk_slot[block_begin.back()] >= block_slots)
         block_begin.push_back(chunk + 1);
     if (block_begin.back() != num_chunks) block_begin.push_back(num_chunks);
   }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 
 #include "implicit_fields.hpp"
 #include "kernels/adaptive_threads.hpp"
@@ -48,6 +49,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         p_records_(detail::kDirection * (soa_.num_nodes + 2)),
         dv_records_(detail::kDirection * (soa_.num_nodes + 2)),
         fields_(soa_, gather_, team_.size()) {
+    gather_.partition(block_slots(gather_.chunk_slot.back(), team_.size()));
     const std::size_t lanes = gather_.lane_node.size();
     system_.resize(gather_.chunk_slot.back(), lanes,
                    options.single_precision_terms && options.cg_tolerance >= kSingleTermsTolerance);
@@ -66,9 +68,6 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       inverse_block_[e].assign(lanes, Real(0));
       cg_.inverse_block[e] = inverse_block_[e].data();
     }
-    // Equal shares of the layout's blocks of chunks (about equal slot counts).
-    for (int m = 0; m <= team_.size(); ++m)
-      member_block_.push_back(static_cast<int>(static_cast<long>(blocks()) * m / team_.size()));
     take_fields(model);
     for (auto& sums : block_sums_)
       sums.assign(3 * static_cast<std::size_t>(blocks()), 0.0);
@@ -214,10 +213,40 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
  private:
   int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
 
+  // Blocks of about this many slots: on a small model the layout's blocks (kBlockSlots) are a
+  // member's share or more, and the members' shares of the work differed by a third.
+  static int block_slots(int slots, int members) {
+    return std::clamp(slots / (32 * members), 256, detail::kBlockSlots);
+  }
+
+  // The members' first blocks, then the number of blocks: equal shares of the work, the springs'
+  // slots and the fields' rows (ImplicitFields::block_work) in one count.
+  void share_blocks() {
+    std::vector<double> work = fields_.block_work();
+    for (int block = 0; block < blocks(); ++block)
+      work[static_cast<std::size_t>(block)] += gather_.chunk_slot[gather_.block_begin[block + 1]] -
+                                               gather_.chunk_slot[gather_.block_begin[block]];
+    const double total = std::accumulate(work.begin(), work.end(), 0.0);
+    member_block_.assign(1, 0);
+    double done = 0.0;
+    for (int block = 0; block < blocks(); ++block) {
+      const double share = total * static_cast<double>(member_block_.size()) / team_.size();
+      // The boundary goes before this block where that leaves the member nearer its share.
+      if (static_cast<int>(member_block_.size()) < team_.size() &&
+          done + 0.5 * work[static_cast<std::size_t>(block)] > share)
+        member_block_.push_back(block);
+      done += work[static_cast<std::size_t>(block)];
+    }
+    while (static_cast<int>(member_block_.size()) <= team_.size())
+      member_block_.push_back(blocks());
+  }
+
   // The fields and the right-hand side vector they add to (kept by the linearising pass only
   // then: it costs a model without fields a store per lane).
   void take_fields(const MechanicalSystem& model) {
-    fields_.take(model, member_block_);
+    fields_.take(model);
+    share_blocks();
+    fields_.plan(member_block_);
     const std::size_t lanes = gather_.lane_node.size();
     for (int c = 0; c < 3; ++c) {
       rhs_[c].assign(fields_.empty() ? 0 : lanes, Real(0));

@@ -32,9 +32,8 @@ class ImplicitFields {
   bool rows() const { return rows_; }
 
   // The model's fields and, per field node, its new id, lane and block (-1 when constrained).
-  // `member_block`: the members' first blocks when the whole team steps, then the number of
-  // blocks.
-  void take(const MechanicalSystem& model, const std::vector<int>& member_block) {
+  // Then block_work, for the caller to share the blocks, and plan.
+  void take(const MechanicalSystem& model) {
     fields_.clear();
     tangents_.clear();
     std::vector<char> used(static_cast<std::size_t>(soa_->num_nodes), 0);
@@ -82,7 +81,25 @@ class ImplicitFields {
                             fields_.empty() ? 0 : static_cast<std::size_t>(soa_->num_nodes),
                             Eigen::Matrix3d::Zero()));
     member_dots_.assign(static_cast<std::size_t>(team_), 0.0);
-    plan_rows(member_block, dofs);
+  }
+
+  // Per block of the layout: what the fields' products cost at its nodes' rows, in spring slots
+  // (ForceField::Tangent::add_row_work).
+  std::vector<double> block_work() const {
+    std::vector<double> per_node(fields_.empty() ? 0 : static_cast<std::size_t>(soa_->num_nodes));
+    for (const auto& tangent : tangents_)
+      tangent->add_row_work(per_node);
+    std::vector<double> work(gather_->block_begin.size() - 1, 0.0);
+    for (const Node& n : nodes_)
+      if (n.block >= 0)
+        work[static_cast<std::size_t>(n.block)] += per_node[static_cast<std::size_t>(n.node)];
+    return work;
+  }
+
+  // The rows of each member's blocks. `member_block`: the members' first blocks when the whole
+  // team steps, then the number of blocks.
+  void plan(const std::vector<int>& member_block) {
+    plan_rows(member_block, 3 * static_cast<Eigen::Index>(soa_->num_nodes));
   }
 
   // Before a product, by the member with plan `plan` (member_plan): h u at every field node into

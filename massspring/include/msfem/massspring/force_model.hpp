@@ -164,6 +164,10 @@ class ForceField : public ForceModel {
     /// nodes first). False, nothing planned, where the tangent has no rows (by default) or its
     /// field has a velocity term (∂f/∂v ≠ 0), which rows do not give. Called before set_part.
     virtual bool plan_rows(const std::vector<std::vector<int>>& /*plans*/) { return false; }
+    /// work[i] += what a product costs at node i's row, in spring slots (one spring seen from one
+    /// end in the fast stepper's kernels), so that a caller who shares the rows among threads
+    /// gives each an equal share; nothing by default (a field whose products cost little).
+    virtual void add_row_work(std::vector<double>& /*work*/) const {}
     /// df += (∂f/∂x) dx at the rows of plan `plan`, the other entries untouched, once set_part has
     /// run for every part; dx must hold every one of the field's nodes.
     virtual void add_product_rows(const Eigen::VectorXd& /*dx*/, Eigen::VectorXd& /*df*/,
