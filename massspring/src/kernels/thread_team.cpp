@@ -3,17 +3,14 @@
 namespace msfem::massspring::detail {
 namespace {
 
-inline void pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#endif
-}
-
 inline void spin_pause(int& spins) {
-  if (++spins > 256)
+  if (++spins > 256) {
     std::this_thread::yield();
-  else
-    pause();
+  } else {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
 }
 
 }  // namespace
@@ -36,20 +33,12 @@ ThreadTeam::~ThreadTeam() {
 void ThreadTeam::worker(int member) {
   long seen = 0;
   while (true) {
-    // Steps come back to back: a worker put to sleep between them is woken through the kernel,
-    // and the caller waits for it at the step's first barrier (12 µs a step on the tet sphere's
-    // implicit step, 6 with this spin). So it spins a while before it sleeps.
-    for (int spins = 0;
-         spins < kWakeSpins && job_generation_.load(std::memory_order_acquire) == seen &&
-         !stopping_.load(std::memory_order_acquire);
-         ++spins)
-      pause();
     const std::function<void(int)>* job = nullptr;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] { return stopping_ || job_generation_ != seen; });
       if (stopping_) return;
-      seen = job_generation_.load(std::memory_order_relaxed);
+      seen = job_generation_;
       job = job_;
     }
     (*job)(member);
@@ -66,7 +55,7 @@ void ThreadTeam::run(const std::function<void(int)>& job) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     job_ = &job;
-    job_generation_.fetch_add(1, std::memory_order_release);
+    ++job_generation_;
   }
   wake_.notify_all();
   job(0);

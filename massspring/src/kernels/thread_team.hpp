@@ -28,16 +28,13 @@ class ThreadTeam {
  private:
   void worker(int member);
 
-  // Pauses a worker spins for the next job before it sleeps: about 100 µs at 25 ns a pause.
-  static constexpr int kWakeSpins = 4000;
-
   int size_;
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_;
   const std::function<void(int)>* job_ = nullptr;
-  std::atomic<long> job_generation_{0};  // read by spinning workers outside the mutex
-  std::atomic<bool> stopping_{false};
+  long job_generation_ = 0;
+  bool stopping_ = false;
   std::atomic<int> finished_{0};
   std::atomic<int> arrived_{0};
   std::atomic<long> barrier_generation_{0};
