@@ -138,7 +138,7 @@ MSFEM_LANE_CLONES void group_gradient(const VolumeBatches& b, int group, const d
 }
 
 MSFEM_LANE_CLONES void group_dot(const VolumeBatches& b, int group, const double* g,
-                                 const double* x, double* out) {
+                                 const double* x, const double* factor, double* out) {
   const int nodes = b.nodes(group);
   const int* offset = b.offset.data() + b.group_start[group];
   alignas(64) double sum[L] = {};
@@ -149,7 +149,7 @@ MSFEM_LANE_CLONES void group_dot(const VolumeBatches& b, int group, const double
       sum[l] += gk[l] * x[at[l]] + gk[L + l] * x[at[l] + 1] + gk[2 * L + l] * x[at[l] + 2];
   }
   for (int l = 0; l < L; ++l)
-    out[l] = sum[l];
+    out[l] = factor[l] * sum[l];
 }
 
 void scatter_group(const VolumeBatches& b, int group, const double* g, const double* s, double* f) {
@@ -164,8 +164,8 @@ void scatter_group(const VolumeBatches& b, int group, const double* g, const dou
 }
 
 MSFEM_LANE_CLONES void group_dot_pair(const VolumeBatches& b, int group, const double* g,
-                                      const double* x1, const double* x2, double* out1,
-                                      double* out2) {
+                                      const double* x1, const double* x2, const double* factor,
+                                      const double* base1, double* out1, double* out2) {
   const int nodes = b.nodes(group);
   const int* offset = b.offset.data() + b.group_start[group];
   alignas(64) double sum1[L] = {}, sum2[L] = {};
@@ -178,8 +178,8 @@ MSFEM_LANE_CLONES void group_dot_pair(const VolumeBatches& b, int group, const d
     }
   }
   for (int l = 0; l < L; ++l) {
-    out1[l] = sum1[l];
-    out2[l] = sum2[l];
+    out1[l] = (base1 ? base1[l] : 0.0) + factor[l] * sum1[l];
+    out2[l] = factor[l] * sum2[l];
   }
 }
 

@@ -52,15 +52,19 @@ VolumeBatches batch_elements(const std::vector<int>& element_start,
 /// The lanes' volumes V and g = −6 ∂V/∂x at their nodes (g[(3k + c)·L + l]), from positions x.
 void group_gradient(const VolumeBatches& b, int group, const double* x, double* g, double* volume);
 
-/// out[l] = Σ_k g_k(l) · x[node k of lane l] on every lane (group_gradient's g layout).
-void group_dot(const VolumeBatches& b, int group, const double* g, const double* x, double* out);
+/// out[l] = factor[l] Σ_k g_k(l) · x[node k of lane l] on every lane (group_gradient's g layout;
+/// factor and out at the group's first lane).
+void group_dot(const VolumeBatches& b, int group, const double* g, const double* x,
+               const double* factor, double* out);
 
 /// f[node k of lane l] += s[l] g_k(l) for the group's filled lanes.
 void scatter_group(const VolumeBatches& b, int group, const double* g, const double* s, double* f);
 
-/// group_dot for two vectors in one pass over g: out1 from x1, out2 from x2.
+/// group_dot for two vectors in one pass over g: out1 from x1 plus base1 (where not null), out2
+/// from x2.
 void group_dot_pair(const VolumeBatches& b, int group, const double* g, const double* x1,
-                    const double* x2, double* out1, double* out2);
+                    const double* x2, const double* factor, const double* base1, double* out1,
+                    double* out2);
 
 /// scatter_group for two vectors in one pass over g: f1 with s1, f2 with s2.
 void scatter_group_pair(const VolumeBatches& b, int group, const double* g, const double* s1,

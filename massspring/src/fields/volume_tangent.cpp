@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "fields/volume_batches.hpp"
+#include "fields/volume_rows.hpp"
 #include "msfem/massspring/volume_force_field.hpp"
 
 namespace msfem::massspring {
@@ -22,12 +23,9 @@ namespace msfem::massspring {
 class DefiniteVolumeTangent final : public ForceField::Tangent {
  public:
   DefiniteVolumeTangent(const VolumeForceField& field, const Eigen::VectorXd& x)
-      : field_(&field),
-        batches_(field.batches_.get()),
-        x_(&x),
-        g_(3 * batches_->offset.size()),
-        scale_(static_cast<std::size_t>(batches_->num_groups()) * L, 0.0),
-        pressure_(scale_.size(), 0.0) {}
+      : field_(&field), batches_(field.batches_.get()), x_(&x), g_(3 * batches_->offset.size()) {
+    set_lane_constants();
+  }
 
   // Gradients and volumes of this part's groups; the lanes a group does not fill keep scale 0.
   void set_part(int part, int parts) override {
@@ -46,14 +44,10 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     for_each_group(part, parts, [&](int group) {
       set_group(group);
       const double* g = gradient(group);
-      double dot1[L], dot2[L];
-      detail::group_dot_pair(*batches_, group, g, dx1.data(), dx2.data(), dot1, dot2);
+      const std::size_t first = static_cast<std::size_t>(group) * L;
       double s1[L], s2[L];
-      for (int l = 0; l < L; ++l) {
-        const std::size_t lane = static_cast<std::size_t>(group) * L + l;
-        s1[l] = pressure_[lane] / 6.0 - scale_[lane] / 36.0 * dot1[l];
-        s2[l] = -scale_[lane] / 36.0 * dot2[l];
-      }
+      detail::group_dot_pair(*batches_, group, g, dx1.data(), dx2.data(), &factor_[first],
+                             &force_[first], s1, s2);
       detail::scatter_group_pair(*batches_, group, g, s1, f.data(), s2, df2.data());
       add_group_blocks(group, cx, blocks);
     });
@@ -70,13 +64,10 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                              int parts) const override {
     for_each_group(part, parts, [&](int group) {
       const double* g = gradient(group);
+      const std::size_t first = static_cast<std::size_t>(group) * L;
       double s1[L], s2[L];
-      detail::group_dot_pair(*batches_, group, g, dx1.data(), dx2.data(), s1, s2);
-      for (int l = 0; l < L; ++l) {
-        const double scale = -scale_[static_cast<std::size_t>(group) * L + l] / 36.0;
-        s1[l] *= scale;
-        s2[l] *= scale;
-      }
+      detail::group_dot_pair(*batches_, group, g, dx1.data(), dx2.data(), &factor_[first], nullptr,
+                             s1, s2);
       detail::scatter_group_pair(*batches_, group, g, s1, df1.data(), s2, df2.data());
     });
   }
@@ -85,10 +76,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   // explicit pass's work without its second read of x.
   bool add_force_part(Eigen::VectorXd& f, int part, int parts) const override {
     for_each_group(part, parts, [&](int group) {
-      double s[L];
-      for (int l = 0; l < L; ++l)
-        s[l] = pressure_[static_cast<std::size_t>(group) * L + l] / 6.0;
-      detail::scatter_group(*batches_, group, gradient(group), s, f.data());
+      detail::scatter_group(*batches_, group, gradient(group),
+                            &force_[static_cast<std::size_t>(group) * L], f.data());
     });
     return true;
   }
@@ -132,7 +121,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
       }
       p.s.assign(scale_.size(), 0.0);
       p.s2.assign(scale_.size(), 0.0);
-      p.g_rows.assign(3 * p.lane.size(), 0.0);
+      p.g_rows.assign(4 * p.lane.size(), 0.0);
+      p.row_out.assign(16 * p.rows.size(), 0.0);
     }
     return true;
   }
@@ -149,37 +139,23 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
     for (int group : p.groups) {
-      double dot[L];
-      detail::group_dot(*batches_, group, gradient(group), dx.data(), dot);
-      for (int l = 0; l < L; ++l) {
-        const std::size_t lane = static_cast<std::size_t>(group) * L + l;
-        p.s[lane] = -scale_[lane] / 36.0 * dot[l];
-      }
+      const std::size_t first = static_cast<std::size_t>(group) * L;
+      detail::group_dot(*batches_, group, gradient(group), dx.data(), &factor_[first], &p.s[first]);
     }
-    const auto sum_rows = [&](auto g_of) {
-      for (std::size_t r = 0; r < p.rows.size(); ++r) {
-        double f[3] = {0.0, 0.0, 0.0};
-        for (int i = p.row_start[r]; i < p.row_start[r + 1]; ++i) {
-          const double s = p.s[static_cast<std::size_t>(p.lane[i])];
-          const auto [gx, gy, gz] = g_of(i);
-          f[0] += s * gx;
-          f[1] += s * gy;
-          f[2] += s * gz;
-        }
-        for (int c = 0; c < 3; ++c)
-          df[3 * p.rows[r] + c] += f[c];
-      }
-    };
     if (p.rows_gathered) {
-      sum_rows([&](int i) {
-        const double* g = p.g_rows.data() + 3 * static_cast<std::size_t>(i);
-        return std::array<double, 3>{g[0], g[1], g[2]};
-      });
-    } else {
-      sum_rows([&](int i) {
+      detail::add_row_sums(incidences(p), p.s.data(), df.data());
+      return;
+    }
+    for (std::size_t r = 0; r < p.rows.size(); ++r) {
+      double f[3] = {0.0, 0.0, 0.0};
+      for (int i = p.row_start[r]; i < p.row_start[r + 1]; ++i) {
+        const double s = p.s[static_cast<std::size_t>(p.lane[i])];
         const double* g = g_.data() + p.g_at[i];
-        return std::array<double, 3>{g[0], g[L], g[2 * L]};
-      });
+        for (int c = 0; c < 3; ++c)
+          f[c] += s * g[c * L];
+      }
+      for (int c = 0; c < 3; ++c)
+        df[3 * p.rows[r] + c] += f[c];
     }
   }
 
@@ -190,56 +166,30 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                   int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
     for (int group : p.groups) {
-      double dot1[L], dot2[L];
-      detail::group_dot_pair(*batches_, group, gradient(group), dx1.data(), dx2.data(), dot1, dot2);
-      for (int l = 0; l < L; ++l) {
-        const std::size_t lane = static_cast<std::size_t>(group) * L + l;
-        p.s[lane] = pressure_[lane] / 6.0 - scale_[lane] / 36.0 * dot1[l];
-        p.s2[lane] = -scale_[lane] / 36.0 * dot2[l];
-      }
+      const std::size_t first = static_cast<std::size_t>(group) * L;
+      detail::group_dot_pair(*batches_, group, gradient(group), dx1.data(), dx2.data(),
+                             &factor_[first], &force_[first], &p.s[first], &p.s2[first]);
     }
-    const double c = cx / 36.0;
+    detail::start_row_sums(incidences(p), p.g_at.data(), g_.data(), p.g_rows.data(), p.s.data(),
+                           p.s2.data(), scale_.data(), cx / 36.0, p.row_out.data());
     for (std::size_t r = 0; r < p.rows.size(); ++r) {
-      double f1[3] = {0.0, 0.0, 0.0}, f2[3] = {0.0, 0.0, 0.0},
-             e[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-      for (int i = p.row_start[r]; i < p.row_start[r + 1]; ++i) {
-        const std::size_t lane = static_cast<std::size_t>(p.lane[i]);
-        const double* g = g_.data() + p.g_at[i];
-        const double gx = g[0], gy = g[L], gz = g[2 * L];
-        double* row_g = p.g_rows.data() + 3 * static_cast<std::size_t>(i);
-        row_g[0] = gx;
-        row_g[1] = gy;
-        row_g[2] = gz;
-        const double s1 = p.s[lane], s2 = p.s2[lane], k = c * scale_[lane];
-        f1[0] += s1 * gx;
-        f1[1] += s1 * gy;
-        f1[2] += s1 * gz;
-        f2[0] += s2 * gx;
-        f2[1] += s2 * gy;
-        f2[2] += s2 * gz;
-        const double kx = k * gx, ky = k * gy;
-        e[0] += kx * gx;
-        e[1] += ky * gy;
-        e[2] += k * gz * gz;
-        e[3] += kx * gy;
-        e[4] += kx * gz;
-        e[5] += ky * gz;
-      }
+      const double* sums = p.row_out.data() + 16 * r;  // f1, f2, diagonal, off-diagonal (xy yz zx)
       const int node = p.rows[r];
       for (int q = 0; q < 3; ++q) {
-        f[3 * node + q] += f1[q];
-        df2[3 * node + q] += f2[q];
+        f[3 * node + q] += sums[q];
+        df2[3 * node + q] += sums[4 + q];
       }
+      const double* e = sums + 8;
       double* m = blocks[static_cast<std::size_t>(node)].data();  // column-major
       m[0] -= e[0];
       m[4] -= e[1];
       m[8] -= e[2];
-      m[1] -= e[3];
-      m[3] -= e[3];
-      m[2] -= e[4];
-      m[6] -= e[4];
+      m[1] -= e[4];
+      m[3] -= e[4];
       m[5] -= e[5];
       m[7] -= e[5];
+      m[2] -= e[6];
+      m[6] -= e[6];
     }
     p.rows_gathered = true;
   }
@@ -254,15 +204,29 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   static constexpr int L = detail::kVolumeLanes;
 
   void set_group(int group) {
-    const auto& elements = field_->elements_;
     double volume[L];
     detail::group_gradient(*batches_, group, x_->data(), gradient(group), volume);
     for (int l = 0; l < L; ++l) {
       const std::size_t lane = static_cast<std::size_t>(group) * L + l;
+      force_[lane] = scale_[lane] * (volume[l] - rest_[lane]) / 6.0;
+    }
+  }
+
+  // What does not change with the state, per group lane; scale 0 on the lanes a group does not
+  // fill.
+  void set_lane_constants() {
+    const auto& elements = field_->elements_;
+    const std::size_t lanes = static_cast<std::size_t>(batches_->num_groups()) * L;
+    scale_.assign(lanes, 0.0);
+    factor_.assign(lanes, 0.0);
+    rest_.assign(lanes, 0.0);
+    force_.assign(lanes, 0.0);
+    for (std::size_t lane = 0; lane < lanes; ++lane) {
       const int e = batches_->element[lane];
-      const double rest = elements.rest_volume[e];
-      scale_[lane] = l < batches_->group_lanes[group] ? elements.modulus[e] / std::abs(rest) : 0.0;
-      pressure_[lane] = scale_[lane] * (volume[l] - rest);
+      rest_[lane] = elements.rest_volume[e];
+      if (static_cast<int>(lane % L) < batches_->group_lanes[lane / L])
+        scale_[lane] = elements.modulus[e] / std::abs(rest_[lane]);
+      factor_[lane] = -scale_[lane] / 36.0;
     }
   }
 
@@ -308,9 +272,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   void add_group_product(int group, const Eigen::VectorXd& dx, Eigen::VectorXd& df) const {
     const double* g = gradient(group);
     double s[L];
-    detail::group_dot(*batches_, group, g, dx.data(), s);
-    for (int l = 0; l < L; ++l)
-      s[l] *= -scale_[static_cast<std::size_t>(group) * L + l] / 36.0;
+    detail::group_dot(*batches_, group, g, dx.data(), &factor_[static_cast<std::size_t>(group) * L],
+                      s);
     detail::scatter_group(*batches_, group, g, s, df.data());
   }
   // The groups of part `part` of `parts`: set_part's, so that a thread reads only the gradients
@@ -347,8 +310,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                                field_->elements_.tet_weight.data(), &order);
     batches_ = &own_batches_;
     g_.assign(3 * batches_->offset.size(), 0.0);
-    scale_.assign(static_cast<std::size_t>(batches_->num_groups()) * L, 0.0);
-    pressure_.assign(scale_.size(), 0.0);
+    set_lane_constants();
   }
   double* gradient(int group) { return g_.data() + 3 * batches_->group_start[group]; }
   const double* gradient(int group) const { return g_.data() + 3 * batches_->group_start[group]; }
@@ -361,18 +323,25 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     std::vector<int> groups;         // the groups with an element at a row
     mutable std::vector<double> s;   // per group lane: −κ/|V⁰| (g·dx)/36 at `groups`
     mutable std::vector<double> s2;  // per group lane: start_rows's second factor
-    // Per incidence, its g (x y z) in row order, gathered by start_rows for the step's products.
+    // Per incidence, its g (x y z 0) in row order, gathered by start_rows for the step's products.
     mutable std::vector<double> g_rows;
+    mutable std::vector<double> row_out;  // per row: start_row_sums's 16 sums
     mutable bool rows_gathered = false;
   };
+  static detail::RowIncidences incidences(const RowPlan& p) {
+    return {static_cast<int>(p.rows.size()), p.rows.data(), p.row_start.data(), p.lane.data(),
+            p.g_rows.data()};
+  }
 
   const VolumeForceField* field_;
   const detail::VolumeBatches* batches_;  // the field's, or own_batches_ once rows are planned
   detail::VolumeBatches own_batches_;
   const Eigen::VectorXd* x_;
-  std::vector<double> g_;         // per group, g[(3k + c)·L + l] (group_gradient's layout)
-  std::vector<double> scale_;     // per group lane: κ/|V⁰|, 0 on lanes the group does not fill
-  std::vector<double> pressure_;  // per group lane: κ (V − V⁰)/|V⁰| at set_part
+  std::vector<double> g_;       // per group, g[(3k + c)·L + l] (group_gradient's layout)
+  std::vector<double> scale_;   // per group lane: κ/|V⁰|, 0 on lanes the group does not fill
+  std::vector<double> factor_;  // per group lane: −κ/|V⁰| / 36, a product's factor on g·dx
+  std::vector<double> rest_;    // per group lane: V⁰
+  std::vector<double> force_;   // per group lane: κ (V − V⁰)/|V⁰| / 6 at set_part, on g
   std::vector<RowPlan> plans_;
 };
 
