@@ -36,6 +36,42 @@ inline Double4 broadcast(double a) {
   return Double4{a, a, a, a};
 }
 
+// Four records' x, y and z as three vectors of the four lanes.
+inline void transpose(const Double4 (&r)[4], Double4 (&xyz)[3]) {
+  const Double4 t0 = __builtin_shufflevector(r[0], r[1], 0, 4, 2, 6);  // x0 x1 z0 z1
+  const Double4 t1 = __builtin_shufflevector(r[0], r[1], 1, 5, 3, 7);  // y0 y1 . .
+  const Double4 t2 = __builtin_shufflevector(r[2], r[3], 0, 4, 2, 6);
+  const Double4 t3 = __builtin_shufflevector(r[2], r[3], 1, 5, 3, 7);
+  xyz[0] = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+  xyz[1] = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+  xyz[2] = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+}
+
+// Σ_k g_k · x[node k] per lane, for V vectors at once, over the group's lanes in fours.
+template <int V>
+inline void dot_records(const VolumeBatches& b, int group, const double* g, const int* record,
+                        const double* const (&x)[V], Double4 (&sum)[V][kVolumeLanes / 4]) {
+  constexpr int L = kVolumeLanes;
+  for (auto& per_vector : sum)
+    for (Double4& s : per_vector)
+      s = broadcast(0.0);
+  const int nodes = b.nodes(group);
+  const int* at = record + b.group_start[group];
+  for (int k = 0; k < nodes; ++k)
+    for (int q = 0; q < L / 4; ++q) {
+      const double* gk = g + 3 * k * L + 4 * q;
+      const Double4 gx = load4(gk), gy = load4(gk + L), gz = load4(gk + 2 * L);
+      const int* lanes = at + k * L + 4 * q;
+      for (int v = 0; v < V; ++v) {
+        const Double4 r[4] = {load4(x[v] + lanes[0]), load4(x[v] + lanes[1]),
+                              load4(x[v] + lanes[2]), load4(x[v] + lanes[3])};
+        Double4 xyz[3];
+        transpose(r, xyz);
+        sum[v][q] += gx * xyz[0] + gy * xyz[1] + gz * xyz[2];
+      }
+    }
+}
+
 }  // namespace
 
 MSFEM_ROW_CLONES void add_row_sums(const RowIncidences& rows, const double* s, double* df) {
@@ -77,6 +113,35 @@ MSFEM_ROW_CLONES void start_row_sums(const RowIncidences& rows, const int* g_at,
     store4(o + 4, f2);
     store4(o + 8, diagonal);
     store4(o + 12, off);
+  }
+}
+
+void to_records(const double* x, int nodes, double* records) {
+  for (int i = 0; i < nodes; ++i)
+    for (int c = 0; c < 3; ++c)
+      records[4 * static_cast<long>(i) + c] = x[3 * static_cast<long>(i) + c];
+}
+
+MSFEM_ROW_CLONES void group_dot_records(const VolumeBatches& b, int group, const double* g,
+                                        const int* record, const double* x1, const double* factor,
+                                        double* out1) {
+  Double4 sum[1][kVolumeLanes / 4];
+  dot_records<1>(b, group, g, record, {x1}, sum);
+  for (int q = 0; q < kVolumeLanes / 4; ++q)
+    store4(out1 + 4 * q, load4(factor + 4 * q) * sum[0][q]);
+}
+
+MSFEM_ROW_CLONES void group_dot_pair_records(const VolumeBatches& b, int group, const double* g,
+                                             const int* record, const double* x1, const double* x2,
+                                             const double* factor, const double* base1,
+                                             double* out1, double* out2) {
+  Double4 sum[2][kVolumeLanes / 4];
+  dot_records<2>(b, group, g, record, {x1, x2}, sum);
+  for (int q = 0; q < kVolumeLanes / 4; ++q) {
+    const Double4 f = load4(factor + 4 * q);
+    const Double4 base = base1 ? load4(base1 + 4 * q) : broadcast(0.0);
+    store4(out1 + 4 * q, base + f * sum[0][q]);
+    store4(out2 + 4 * q, f * sum[1][q]);
   }
 }
 

@@ -9,6 +9,8 @@
 
 namespace msfem::massspring::detail {
 
+struct VolumeBatches;
+
 /// Incidences in row order: row r holds [row_start[r], row_start[r + 1]); incidence i takes its
 /// element's factor from lane[i] and its gradient from the record g_rows[4i .. 4i + 3].
 struct RowIncidences {
@@ -28,5 +30,19 @@ void add_row_sums(const RowIncidences& rows, const double* s, double* df);
 /// (xy, yz, zx), each padded to four, with k = c·scale[lane].
 void start_row_sums(const RowIncidences& rows, const int* g_at, const double* g, double* g_rows,
                     const double* s1, const double* s2, const double* scale, double c, double* out);
+
+/// Vectors in records of four doubles per node (x y z, the fourth unread), for the dot kernels
+/// below: one load per node and a transpose of four, instead of three scalar loads put together
+/// lane by lane.
+void to_records(const double* x, int nodes, double* records);
+
+/// group_dot (volume_batches.hpp) from vectors in records: x4 at record[k·L + l] (4 × the node
+/// id, the group layout of b.offset) for node k of lane l. One vector: out1 = factor Σ g·x1.
+/// Two: also out2 = factor Σ g·x2, and base1 (where not null) added to out1.
+void group_dot_records(const VolumeBatches& b, int group, const double* g, const int* record,
+                       const double* x1, const double* factor, double* out1);
+void group_dot_pair_records(const VolumeBatches& b, int group, const double* g, const int* record,
+                            const double* x1, const double* x2, const double* factor,
+                            const double* base1, double* out1, double* out2);
 
 }  // namespace msfem::massspring::detail

@@ -123,6 +123,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
       p.s2.assign(scale_.size(), 0.0);
       p.g_rows.assign(4 * p.lane.size(), 0.0);
       p.row_out.assign(16 * p.rows.size(), 0.0);
+      p.x1.assign(4 * row_of.size(), 0.0);
+      p.x2.assign(4 * row_of.size(), 0.0);
     }
     return true;
   }
@@ -138,9 +140,11 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
 
   void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
+    detail::to_records(dx.data(), static_cast<int>(dx.size() / 3), p.x1.data());
     for (int group : p.groups) {
       const std::size_t first = static_cast<std::size_t>(group) * L;
-      detail::group_dot(*batches_, group, gradient(group), dx.data(), &factor_[first], &p.s[first]);
+      detail::group_dot_records(*batches_, group, gradient(group), record_.data(), p.x1.data(),
+                                &factor_[first], &p.s[first]);
     }
     if (p.rows_gathered) {
       detail::add_row_sums(incidences(p), p.s.data(), df.data());
@@ -165,10 +169,13 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                   Eigen::VectorXd& df2, double cx, std::vector<Eigen::Matrix3d>& blocks,
                   int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
+    detail::to_records(dx1.data(), static_cast<int>(dx1.size() / 3), p.x1.data());
+    detail::to_records(dx2.data(), static_cast<int>(dx2.size() / 3), p.x2.data());
     for (int group : p.groups) {
       const std::size_t first = static_cast<std::size_t>(group) * L;
-      detail::group_dot_pair(*batches_, group, gradient(group), dx1.data(), dx2.data(),
-                             &factor_[first], &force_[first], &p.s[first], &p.s2[first]);
+      detail::group_dot_pair_records(*batches_, group, gradient(group), record_.data(), p.x1.data(),
+                                     p.x2.data(), &factor_[first], &force_[first], &p.s[first],
+                                     &p.s2[first]);
     }
     detail::start_row_sums(incidences(p), p.g_at.data(), g_.data(), p.g_rows.data(), p.s.data(),
                            p.s2.data(), scale_.data(), cx / 36.0, p.row_out.data());
@@ -212,9 +219,12 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     }
   }
 
-  // What does not change with the state, per group lane; scale 0 on the lanes a group does not
-  // fill.
+  // What does not change with the state, per group lane (scale 0 on the lanes a group does not
+  // fill), and each node's record in the group layout.
   void set_lane_constants() {
+    record_.resize(batches_->offset.size());
+    for (std::size_t i = 0; i < record_.size(); ++i)
+      record_[i] = batches_->offset[i] / 3 * 4;
     const auto& elements = field_->elements_;
     const std::size_t lanes = static_cast<std::size_t>(batches_->num_groups()) * L;
     scale_.assign(lanes, 0.0);
@@ -326,6 +336,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     // Per incidence, its g (x y z 0) in row order, gathered by start_rows for the step's products.
     mutable std::vector<double> g_rows;
     mutable std::vector<double> row_out;  // per row: start_row_sums's 16 sums
+    mutable std::vector<double> x1, x2;   // the products' vectors in records (detail::to_records)
     mutable bool rows_gathered = false;
   };
   static detail::RowIncidences incidences(const RowPlan& p) {
@@ -341,6 +352,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   std::vector<double> scale_;   // per group lane: κ/|V⁰|, 0 on lanes the group does not fill
   std::vector<double> factor_;  // per group lane: −κ/|V⁰| / 36, a product's factor on g·dx
   std::vector<double> rest_;    // per group lane: V⁰
+  std::vector<int> record_;     // per group slot (b.offset's layout): 4 × the node id
   std::vector<double> force_;   // per group lane: κ (V − V⁰)/|V⁰| / 6 at set_part, on g
   std::vector<RowPlan> plans_;
 };
