@@ -148,7 +148,12 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         fields_.start_part(member, members, dt);
         if (members > 1) team_.barrier();
         fields_.start_apply(b0, b1, members, plan, cg_, p_records_.data(), dt);
-        reduced([&](int block, double* out) { start_sums(block, out); }, sums);
+        reduced(
+            [&](int block, double* out) {
+              start_sums(block, out);
+              if (fields_.rows()) fields_.share_direction(plan, block, p_records_.data(), dt);
+            },
+            sums);
       }
       double gamma = sums[0], rr = sums[1], alpha = 0.0, previous_gamma = 0.0;
       const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
@@ -156,7 +161,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       while (iteration < options_.cg_max_iterations && rr > target) {
         double delta[3];  // u·A u
         if (fields_.rows())
-          fields_.rows_product(plan, p_records_.data(), dt);
+          fields_.rows_product(plan);
         else if (!fields_.empty())
           fields_.gather_direction(b0, b1, p_records_.data(), dt);
         reduced(
@@ -187,6 +192,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
                                   static_cast<Real>(beta), gather_.block_begin[block],
                                   gather_.block_begin[block + 1], local);
               std::copy(local, local + 3, out);
+              if (fields_.rows()) fields_.share_direction(plan, block, p_records_.data(), dt);
             },
             next);
         previous_gamma = gamma;

@@ -102,19 +102,26 @@ class ImplicitFields {
     plan_rows(member_block, 3 * static_cast<Eigen::Index>(soa_->num_nodes));
   }
 
-  // Before a product, by the member with plan `plan` (member_plan): h u at every field node into
-  // its own vector (u of every node is complete in `u_records` since the last reduction), and the
-  // fields' rows -A_F u / h = K_F (h u) at its nodes.
-  void rows_product(int plan, const Real* u_records, double h) {
-    Eigen::VectorXd& hu = plan_u_[static_cast<std::size_t>(plan)];
-    Eigen::VectorXd& y = plan_y_[static_cast<std::size_t>(plan)];
-    for (const Node& n : nodes_)
+  // Once u is final at block `block`'s lanes, before the reduction's barrier: h u at the field
+  // nodes of plan `plan` there into the vector every member's next rows_product reads (each
+  // member copies its own nodes once, not every node for itself).
+  void share_direction(int plan, int block, const Real* u_records, double h) {
+    const auto& nodes = plan_nodes_[static_cast<std::size_t>(plan)];
+    const auto& start = plan_block_start_[static_cast<std::size_t>(plan)];
+    for (auto n = nodes.begin() + start[block]; n != nodes.begin() + start[block + 1]; ++n)
       for (int c = 0; c < 3; ++c)
-        hu[3 * n.node + c] = h * u_records[kDirection * n.id + c];
+        hu_[3 * n->node + c] = h * u_records[kDirection * n->id + c];
+  }
+
+  // Before a product, by the member with plan `plan` (member_plan), once every member has shared
+  // its h u (share_direction) and passed the barrier: the fields' rows -A_F u / h = K_F (h u) at
+  // its nodes.
+  void rows_product(int plan) {
+    Eigen::VectorXd& y = plan_y_[static_cast<std::size_t>(plan)];
     for (const Node& n : plan_nodes_[static_cast<std::size_t>(plan)])
       y.template segment<3>(3 * n.node).setZero();
     for (const auto& tangent : tangents_)
-      tangent->add_product_rows(hu, y, plan);
+      tangent->add_product_rows(hu_, y, plan);
   }
 
   // Once the spring product has written w at block `block`'s lanes: w += A_F u at the plan's
