@@ -29,7 +29,7 @@ inline Double4 load4(const double* p) {
   std::memcpy(&v, p, sizeof v);
   return v;
 }
-inline void store4(double* p, Double4 v) {
+inline void store4(double* p, const Double4& v) {
   std::memcpy(p, &v, sizeof v);
 }
 inline Double4 broadcast(double a) {
