@@ -7,7 +7,6 @@
 // row order for the step's products.
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <numeric>
 #include <utility>
