@@ -37,6 +37,24 @@ VolumeForceField shell_prisms(const SpringNetwork& network, double modulus) {
       tier_prisms(network.rest_positions, network.surface_triangles, nv, 3, modulus));
 }
 
+// `steps` backward-Euler steps of h from `start`: the generic integrator solved tightly, or the
+// fast implicit stepper on `threads` threads to the same tolerance.
+State backward_euler(const MassSpringModel& model, const State& start, double h, int steps) {
+  State state = start;
+  Integrator integrator(IntegratorKind::implicit_euler, {1e-13, 5000});
+  for (int n = 0; n < steps; ++n)
+    integrator.step(model, state, h);
+  return state;
+}
+State fast_backward_euler(const MassSpringModel& model, const State& start, double h, int steps,
+                          int threads) {
+  FastImplicitStepper stepper(model, FastImplicitOptions{threads, true, 1e-13, 5000});
+  stepper.set_state(start);
+  for (int n = 0; n < steps; ++n)
+    stepper.step(h);
+  return stepper.state();
+}
+
 TEST(VolumeForceField, JacobiansAndEnergyMatchFiniteDifferences) {
   const SpringNetwork network = three_tier_sphere(1);
   const VolumeForceField volume = shell_prisms(network, 8000.0);
@@ -357,20 +375,14 @@ TEST(VolumeForceField, FastSteppersStepTheVolumeAsTheGenericIntegrators) {
 
   // Backward Euler at a step 100x the explicit one, solved tightly: the same steps on one and two
   // threads, and in float to its precision; the volume's stiffness changed the steps.
-  State backward = start;
-  Integrator backward_integrator(IntegratorKind::implicit_euler, {1e-13, 5000});
   const double h = 1e-3;
-  for (int n = 0; n < 20; ++n)
-    backward_integrator.step(model, backward, h);
+  const State backward = backward_euler(model, start, h, 20);
   const double backward_travel = (backward.x - start.x).norm();
   ASSERT_GT(backward_travel, 1e-6);
-  for (const int threads : {1, 2}) {
-    FastImplicitStepper implicit(model, FastImplicitOptions{threads, true, 1e-13, 5000});
-    implicit.set_state(start);
-    for (int n = 0; n < 20; ++n)
-      implicit.step(h);
-    EXPECT_LT((implicit.state().x - backward.x).norm(), 1e-8 * backward_travel) << threads;
-  }
+  for (const int threads : {1, 2})
+    EXPECT_LT((fast_backward_euler(model, start, h, 20, threads).x - backward.x).norm(),
+              1e-8 * backward_travel)
+        << threads;
   FastImplicitOptions single{2, true, 1e-6, 5000};
   single.single_precision = true;
   FastImplicitStepper implicit_float(model, single);
@@ -446,28 +458,19 @@ TEST(VolumeForceField, FastImplicitStepsTetrahedraAsTheGenericIntegrator) {
   for (int node = n * n * (n - 1); node < n * n * n; ++node)
     start.x[3 * node + 2] -= 0.002;  // the top face pressed down 2 mm
 
-  State backward = start;
-  Integrator backward_integrator(IntegratorKind::implicit_euler, {1e-13, 5000});
   const double h = 1e-3;
-  for (int step = 0; step < 20; ++step)
-    backward_integrator.step(model, backward, h);
+  const State backward = backward_euler(model, start, h, 20);
   const double travel = (backward.x - start.x).norm();
   ASSERT_GT(travel, 1e-5);
-  for (const int threads : {1, 2}) {
-    FastImplicitStepper implicit(model, FastImplicitOptions{threads, true, 1e-13, 5000});
-    implicit.set_state(start);
-    for (int step = 0; step < 20; ++step)
-      implicit.step(h);
-    EXPECT_LT((implicit.state().x - backward.x).norm(), 1e-8 * travel) << threads;
-  }
+  for (const int threads : {1, 2})
+    EXPECT_LT((fast_backward_euler(model, start, h, 20, threads).x - backward.x).norm(),
+              1e-8 * travel)
+        << threads;
   MassSpringModel springs_only(network);
   for (int node = 0; node < n * n; ++node)
     springs_only.fix_node(node);
-  FastImplicitStepper blind(springs_only, FastImplicitOptions{2, true, 1e-13, 5000});
-  blind.set_state(start);
-  for (int step = 0; step < 20; ++step)
-    blind.step(h);
-  EXPECT_GT((blind.state().x - backward.x).norm(), 1e-2 * travel);  // the volume mattered
+  const State blind = fast_backward_euler(springs_only, start, h, 20, 2);
+  EXPECT_GT((blind.x - backward.x).norm(), 1e-2 * travel);  // the volume mattered
 }
 
 }  // namespace
