@@ -144,10 +144,17 @@ std::unique_ptr<MassSpringModel> benchmark_model(const BenchmarkCase& benchmark_
 
 SteppingBenchmarkResult run_benchmark_case(const BenchmarkCase& benchmark_case,
                                            const SteppingBenchmarkOptions& options) {
-  if (benchmark_case.model) return run_stepping_benchmark(*benchmark_case.model, options);
+  SteppingBenchmarkOptions case_options = options;
+  const auto take = [](double& step, double given) {
+    if (given > 0) step = given;
+  };
+  take(case_options.timed_dt.symplectic_euler, benchmark_case.timed_dt.symplectic_euler);
+  take(case_options.timed_dt.explicit_euler, benchmark_case.timed_dt.explicit_euler);
+  take(case_options.timed_dt.rk4, benchmark_case.timed_dt.rk4);
+  if (benchmark_case.model) return run_stepping_benchmark(*benchmark_case.model, case_options);
   std::string note;
   const std::unique_ptr<MassSpringModel> model = benchmark_model(benchmark_case, &note);
-  SteppingBenchmarkResult result = run_stepping_benchmark(*model, options);
+  SteppingBenchmarkResult result = run_stepping_benchmark(*model, case_options);
   if (!note.empty()) result.notes.push_back(note);
   return result;
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "msfem/cases/case_parameters.hpp"
+#include "msfem/compare/pipeline/bench_case.hpp"
 #include "msfem/compare/pipeline/variant_run.hpp"
 #include "msfem/massspring/fast_stepper.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
@@ -40,6 +41,37 @@ TEST(TimingWork, TheSweepAndTheBenchStepTheSameSeedSphere) {
     const double bench_bytes = static_cast<double>(timed_by_bench.streamed_bytes_per_step());
     EXPECT_NEAR(sweep, bench_bytes, 1e-3 * bench_bytes) << ms::to_string(integrator);
   }
+}
+
+// The pressed seed sphere of msfem bench is msfem sweep's model, timed at msfem sweep's step for
+// each explicit integrator (RK4 at half its own bisected stable step, not a hundredth of
+// symplectic Euler's): with the tool in contact a step costs what the trajectory has pressed into
+// the tool, so at another step the two commands would time another state.
+TEST(TimingWork, TheBenchTimesThePressedSphereAtTheSweepsSteps) {
+  const ms::BenchmarkCase bench =
+      sweep_bench_case("seed_sphere_contact", "sphere_indent.prm", cases::Variant::three_tier, {});
+  const cases::CaseParameters parameters =
+      cases::read_case(std::string(MSFEM_CASES_DIR) + "/sphere_indent.prm", {});
+  const Problem problem = make_problem(parameters);
+  const BuiltVariant swept =
+      build_variant(cases::Variant::three_tier, problem, {}, problem.tools.front());
+  ASSERT_TRUE(swept.model->has_added_fields());  // the contact field
+  EXPECT_EQ(bench.model->num_nodes(), swept.model->num_nodes());
+  EXPECT_EQ(bench.model->network().num_springs(), swept.model->network().num_springs());
+  const std::pair<ms::IntegratorKind, double> steps[] = {
+      {ms::IntegratorKind::symplectic_euler, bench.timed_dt.symplectic_euler},
+      {ms::IntegratorKind::explicit_euler, bench.timed_dt.explicit_euler},
+      {ms::IntegratorKind::rk4, bench.timed_dt.rk4}};
+  for (const auto& [integrator, bench_dt] : steps) {
+    cases::TimingParameters timing = parameters.timing;
+    timing.integrator = integrator;
+    timing.steps = 20;
+    const Timing sweep = time_variant(swept, timing, Eigen::VectorXd(), false);
+    EXPECT_EQ(bench_dt, sweep.dt_s) << ms::to_string(integrator);
+    EXPECT_GT(sweep.dt_s, 0.0);
+  }
+  // The three steps are each integrator's own: RK4's is about 80 times explicit Euler's here.
+  EXPECT_GT(bench.timed_dt.rk4, 10.0 * bench.timed_dt.explicit_euler);
 }
 
 // The settle time of msfem run: the seed sphere's three tiers sag under gravity to within 1 % of

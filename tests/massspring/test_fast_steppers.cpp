@@ -9,6 +9,7 @@
 #include "msfem/massspring/mass_spring_model.hpp"
 #include "msfem/massspring/stability.hpp"
 #include "msfem/massspring/topology_builders.hpp"
+#include "msfem/massspring_bench/benchmark_cases.hpp"
 #include "msfem/massspring_bench/stepping_benchmark.hpp"
 
 namespace msfem::massspring {
@@ -346,6 +347,30 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   const std::size_t least = 2 * 8 * sizeof(double) * 486 + 2 * 2 * sizeof(double) * result.springs;
   EXPECT_GE(result.explicit_bytes_per_step, least);
   EXPECT_LT(result.explicit_bytes_per_step, 3 * least);
+}
+
+TEST(SteppingBenchmark, TimesEachIntegratorAtTheStepACaseGives) {
+  const MassSpringModel model = loaded_three_tier();
+  SteppingBenchmarkOptions options;
+  options.seconds_per_sample = 0.01;
+  options.samples = 1;
+  options.run_naive = options.run_implicit = options.compare_precision = false;
+  const SteppingBenchmarkResult own = run_stepping_benchmark(model, options);
+  const double rule =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  EXPECT_EQ(own.explicit_dt, rule);
+  EXPECT_EQ(own.explicit_euler_dt, 0.01 * rule);
+  EXPECT_EQ(own.rk4_dt, 0.01 * rule);
+
+  BenchmarkCase given{"given", "loaded three tiers", model.network()};
+  given.model = std::make_shared<MassSpringModel>(model);
+  given.timed_dt = {0.3 * rule, 0.02 * rule, 0.7 * rule};
+  const SteppingBenchmarkResult chosen = run_benchmark_case(given, options);
+  EXPECT_EQ(chosen.explicit_dt, 0.3 * rule);
+  EXPECT_EQ(chosen.explicit_euler_dt, 0.02 * rule);
+  EXPECT_EQ(chosen.rk4_dt, 0.7 * rule);
+  EXPECT_EQ(chosen.precision_dt, rule);  // float against double keeps the bench's own step
+  EXPECT_GT(chosen.rk4_spread.median, 0.0);
 }
 
 TEST(SteppingBenchmark, StreamTriadMeasuresABandwidth) {

@@ -14,39 +14,13 @@
 #include "msfem/cases/surface_io.hpp"
 #include "msfem/compare/commands/commands.hpp"
 #include "msfem/compare/commands/options.hpp"
-#include "msfem/compare/pipeline/fem_run.hpp"
-#include "msfem/compare/pipeline/variant_run.hpp"
+#include "msfem/compare/pipeline/bench_case.hpp"
 #include "msfem/massspring_bench/benchmark_cases.hpp"
 
 namespace msfem::compare {
 namespace {
 
 constexpr const char* kBrainFile = "brain_icbm152_lh_9177_mm.obj";
-
-// A variant of a shipped case exactly as `msfem sweep` builds and times it at the case's
-// resolution: its FEM mesh (tet_edges), supports, group scales and tool at depth (a bonded patch,
-// or the frictionless contact field), so that the two commands' figures are of one model.
-massspring::BenchmarkCase case_variant(const std::string& name, const std::string& case_file,
-                                       cases::Variant variant,
-                                       const std::vector<std::string>& settings) {
-  const std::filesystem::path file = std::filesystem::path(MSFEM_DEFAULT_CASES_DIR) / case_file;
-  const cases::CaseParameters parameters = cases::read_case(file, settings);
-  const Problem problem = make_problem(parameters);
-  fem_reference::VolumeMesh mesh;
-  if (variant == cases::Variant::tet_edges) mesh = mesh_problem(problem);
-  std::optional<ToolPlacement> tool;
-  if (!problem.tools.empty()) tool = problem.tools.front();
-  BuiltVariant built = build_variant(variant, problem, mesh, tool);
-  massspring::BenchmarkCase c;
-  c.name = name;
-  c.description = built.name + " of " + case_file + " as msfem sweep times it";
-  for (const std::string& setting : settings)
-    c.description += ", " + setting;
-  c.network = built.model->network();
-  c.volume_preservation = parameters.mass_spring.volume_preservation;
-  c.model = std::move(built.model);
-  return c;
-}
 
 const std::vector<std::string> kBuiltinCases = {"seed_sphere", "brain_scale", "brain_scale_volume",
                                                 "brain_10x"};
@@ -87,12 +61,12 @@ std::vector<massspring::BenchmarkCase> built_cases(
   if (std::any_of(kBuiltinCases.begin(), kBuiltinCases.end(), named))
     all = massspring::benchmark_cases(brain_vertices, brain_triangles, named("brain_10x"));
   if (named("seed_sphere_contact"))
-    all.push_back(
-        case_variant("seed_sphere_contact", "sphere_indent.prm", cases::Variant::three_tier, {}));
+    all.push_back(sweep_bench_case("seed_sphere_contact", "sphere_indent.prm",
+                                   cases::Variant::three_tier, {}));
   if (named("seed_sphere_tet_edges_volume"))
-    all.push_back(case_variant("seed_sphere_tet_edges_volume", "sphere_indent_bonded.prm",
-                               cases::Variant::tet_edges,
-                               {"mass spring/volume preservation=true"}));
+    all.push_back(sweep_bench_case("seed_sphere_tet_edges_volume", "sphere_indent_bonded.prm",
+                                   cases::Variant::tet_edges,
+                                   {"mass spring/volume preservation=true"}));
   std::vector<massspring::BenchmarkCase> chosen;
   for (const std::string& name : wanted)
     for (auto& c : all)
@@ -105,9 +79,10 @@ nlohmann::json spread_json(const massspring::RateSpread& s) {
   return {{"min", s.min}, {"median", s.median}, {"max", s.max}};
 }
 
-nlohmann::json precision_json(const std::optional<massspring::PrecisionComparison>& p) {
+nlohmann::json precision_json(const std::optional<massspring::PrecisionComparison>& p, double dt) {
   if (!p) return nullptr;
   return {{"steps", p->steps},
+          {"dt_s", dt},
           {"max_node_error_m", p->max_node_error_m},
           {"max_displacement_m", p->max_displacement_m},
           {"max_node_error_over_max_displacement", p->relative()}};
@@ -121,41 +96,49 @@ nlohmann::json to_json(const massspring::BenchmarkCase& c,
   nlohmann::json warnings = c.network.warnings;
   for (const auto& note : r.notes)
     warnings.push_back(note);
-  return {{"name", c.name},
-          {"volume_preservation", c.volume_preservation},
-          {"description", c.description},
-          {"nodes", r.nodes},
-          {"springs", r.springs},
-          {"threads", r.threads},
-          {"explicit_last_step_threads", r.explicit_last_step_threads},
-          {"explicit_steps_per_second", r.explicit_steps_per_second},
-          {"naive_steps_per_second", r.naive_steps_per_second},
-          {"speedup_over_naive", r.naive_steps_per_second > 0.0
-                                     ? r.explicit_steps_per_second / r.naive_steps_per_second
-                                     : 0.0},
-          {"implicit_steps_per_second", r.implicit_steps_per_second},
-          {"implicit_mean_cg_iterations", r.implicit_mean_cg_iterations},
-          {"implicit_single_precision_terms", r.implicit_single_precision_terms},
-          {"explicit_steps_per_second_spread", spread_json(r.explicit_spread)},
-          {"naive_steps_per_second_spread", spread_json(r.naive_spread)},
-          {"implicit_steps_per_second_spread", spread_json(r.implicit_spread)},
-          {"steps_per_second_by_integrator",
-           {{"symplectic_euler", spread_json(r.explicit_spread)},
-            {"central_difference", spread_json(r.explicit_spread)},
-            {"explicit_euler", spread_json(r.explicit_euler_spread)},
-            {"rk4", spread_json(r.rk4_spread)},
-            {"implicit_euler", spread_json(r.implicit_spread)}}},
-          {"float_vs_double", precision_json(r.float_vs_double)},
-          {"explicit_bytes_per_step", r.explicit_bytes_per_step},
-          {"explicit_bytes_per_second", explicit_bandwidth},
-          {"explicit_fraction_of_stream_bandwidth", stream > 0 ? explicit_bandwidth / stream : 0.0},
-          {"working_set_bytes", r.explicit_bytes_per_step},
-          {"working_set_triad_bytes_per_second", at_working_set},
-          {"fraction_of_working_set_roofline",
-           at_working_set > 0 ? explicit_bandwidth / at_working_set : 0.0},
-          {"explicit_dt_s", r.explicit_dt},
-          {"implicit_dt_s", options.implicit_dt},
-          {"warnings", warnings}};
+  return {
+      {"name", c.name},
+      {"volume_preservation", c.volume_preservation},
+      {"description", c.description},
+      {"nodes", r.nodes},
+      {"springs", r.springs},
+      {"threads", r.threads},
+      {"explicit_last_step_threads", r.explicit_last_step_threads},
+      {"explicit_steps_per_second", r.explicit_steps_per_second},
+      {"naive_steps_per_second", r.naive_steps_per_second},
+      {"speedup_over_naive", r.naive_steps_per_second > 0.0
+                                 ? r.explicit_steps_per_second / r.naive_steps_per_second
+                                 : 0.0},
+      {"implicit_steps_per_second", r.implicit_steps_per_second},
+      {"implicit_mean_cg_iterations", r.implicit_mean_cg_iterations},
+      {"implicit_single_precision_terms", r.implicit_single_precision_terms},
+      {"explicit_steps_per_second_spread", spread_json(r.explicit_spread)},
+      {"naive_steps_per_second_spread", spread_json(r.naive_spread)},
+      {"implicit_steps_per_second_spread", spread_json(r.implicit_spread)},
+      {"steps_per_second_by_integrator",
+       {{"symplectic_euler", spread_json(r.explicit_spread)},
+        {"central_difference", spread_json(r.explicit_spread)},
+        {"explicit_euler", spread_json(r.explicit_euler_spread)},
+        {"rk4", spread_json(r.rk4_spread)},
+        {"implicit_euler", spread_json(r.implicit_spread)}}},
+      {"float_vs_double", precision_json(r.float_vs_double, r.precision_dt)},
+      {"explicit_bytes_per_step", r.explicit_bytes_per_step},
+      {"explicit_bytes_per_second", explicit_bandwidth},
+      {"explicit_fraction_of_stream_bandwidth", stream > 0 ? explicit_bandwidth / stream : 0.0},
+      {"working_set_bytes", r.explicit_bytes_per_step},
+      {"working_set_triad_bytes_per_second", at_working_set},
+      {"fraction_of_working_set_roofline",
+       at_working_set > 0 ? explicit_bandwidth / at_working_set : 0.0},
+      {"explicit_dt_s", r.explicit_dt},
+      {"implicit_dt_s", options.implicit_dt},
+      {"dt_s_by_integrator",
+       {{"symplectic_euler", r.explicit_dt},
+        {"central_difference", r.explicit_dt},
+        {"explicit_euler", r.explicit_euler_dt > 0 ? nlohmann::json(r.explicit_euler_dt) : nullptr},
+        {"rk4", r.rk4_dt > 0 ? nlohmann::json(r.rk4_dt) : nullptr},
+        {"implicit_euler",
+         r.implicit_steps_per_second > 0 ? nlohmann::json(options.implicit_dt) : nullptr}}},
+      {"warnings", warnings}};
 }
 
 // The brain surface the brain cases are built on, or none (a sphere of its size stands in).

@@ -38,7 +38,7 @@ double metric_value(const ToolLoadVariant& v, Metric metric) {
   return std::nan("");
 }
 
-std::string number(double x) {
+std::string six_digits(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", x);
   return text;
@@ -51,7 +51,7 @@ bool finite(const nlohmann::json& j) {
 void compare_metric(const std::string& case_name, const ToolLoadVariant& v, Metric metric,
                     const nlohmann::json& base, std::vector<RegressionRow>& rows) {
   const std::string name = metric_name(metric);
-  RegressionRow row{case_name, v.name, name, "-", number(metric_value(v, metric)), "-", "ok"};
+  RegressionRow row{case_name, v.name, name, "-", six_digits(metric_value(v, metric)), "-", "ok"};
   const double now = metric_value(v, metric);
   if (!base.contains(name)) {
     row.status = "MISSING";
@@ -69,8 +69,8 @@ void compare_metric(const std::string& case_name, const ToolLoadVariant& v, Metr
   const double base_v = magnitude ? std::abs(value) : value,
                now_v = magnitude ? std::abs(now) : now;
   const double tol = abs_tol + rel_tol * std::abs(value);
-  row.baseline = number(value);
-  row.tolerance = number(tol);
+  row.baseline = six_digits(value);
+  row.tolerance = six_digits(tol);
   if (now_v > base_v + tol) row.status = "WORSE";
   if (now_v < base_v - tol) row.status = "improved";
   rows.push_back(row);
@@ -113,9 +113,9 @@ void compare_field(const std::string& case_name, const ToolLoadVariant& v,
   const double max_diff = (v.surface_displacement - reference).cwiseAbs().maxCoeff();
   const auto& f = base.at("field");
   const double tol = f.at("abs_tol_m").get<double>() + f.at("rel_tol").get<double>() * max_base;
-  row.baseline = "max |u| " + number(max_base);
-  row.now = "max diff " + number(max_diff);
-  row.tolerance = number(tol);
+  row.baseline = "max |u| " + six_digits(max_base);
+  row.now = "max diff " + six_digits(max_diff);
+  row.tolerance = six_digits(tol);
   if (max_diff > tol) row.status = "WORSE";
   rows.push_back(row);
 }

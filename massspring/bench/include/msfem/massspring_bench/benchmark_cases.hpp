@@ -32,6 +32,9 @@ struct BenchmarkCase {
   /// needs a mesher massspring does not have): stepped as it is, `network` and
   /// `volume_preservation` only describing it.
   std::shared_ptr<const MassSpringModel> model = nullptr;
+  /// The steps its explicit integrators are timed at (SteppingBenchmarkOptions::timed_dt); 0: the
+  /// bench's own rule.
+  ExplicitTimedSteps timed_dt = {};
 };
 
 /// The three cases of `msfem bench massspring`:

@@ -35,8 +35,19 @@ class NaiveAosStepper {
   double time_ = 0.0;
 };
 
+/// The step each explicit integrator is timed at, where a case's owner chose it (msfem's harness
+/// gives its shipped cases msfem sweep's steps: half each integrator's bisected stable step);
+/// 0: the bench's own rule (symplectic Euler at half the predicted stable step, explicit Euler and
+/// RK4 at a hundredth of that).
+struct ExplicitTimedSteps {
+  double symplectic_euler = 0.0;  ///< and central difference, the same kernels at the same step
+  double explicit_euler = 0.0;
+  double rk4 = 0.0;
+};
+
 struct SteppingBenchmarkOptions {
   int threads = 2;
+  ExplicitTimedSteps timed_dt;      ///< where 0, the bench's own rule
   bool single_precision = false;    ///< float for the explicit and the implicit fast stepper
   int steps_per_call = 10;          ///< explicit steps per FastExplicitStepper::step call
   double seconds_per_sample = 0.2;  ///< each sample runs at least this long
@@ -77,14 +88,16 @@ struct SteppingBenchmarkResult {
   int nodes = 0;
   int springs = 0;
   int threads = 0;
-  double explicit_dt = 0.0;                ///< 0.5 × predicted stable dt
-  double explicit_steps_per_second = 0.0;  ///< FastExplicitStepper, median
-  double naive_steps_per_second = 0.0;     ///< NaiveAosStepper, median (0 when not run)
-  double implicit_steps_per_second = 0.0;  ///< FastImplicitStepper, median (0 when not run)
+  double explicit_dt = 0.0;  ///< symplectic Euler's step: 0.5 × predicted stable dt, or as given
+  double explicit_euler_dt = 0.0, rk4_dt = 0.0;  ///< the steps the other two were timed at
+  double precision_dt = 0.0;                     ///< float_vs_double's: 0.5 × predicted stable dt
+  double explicit_steps_per_second = 0.0;        ///< FastExplicitStepper, median
+  double naive_steps_per_second = 0.0;           ///< NaiveAosStepper, median (0 when not run)
+  double implicit_steps_per_second = 0.0;        ///< FastImplicitStepper, median (0 when not run)
   double implicit_mean_cg_iterations = 0.0;
   bool implicit_single_precision_terms = false;  ///< FastImplicitStepper::single_precision_terms
   RateSpread explicit_spread, naive_spread, implicit_spread;
-  RateSpread explicit_euler_spread, rk4_spread;  ///< at explicit_dt / 100
+  RateSpread explicit_euler_spread, rk4_spread;  ///< at explicit_euler_dt, rk4_dt
   std::size_t explicit_bytes_per_step = 0;
   int explicit_last_step_threads = 0;  ///< where adaptive threads ended (1 or threads)  ///<
                                        ///< FastExplicitStepper::streamed_bytes_per_step
