@@ -140,9 +140,16 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
     detail::to_records(dx.data(), static_cast<int>(dx.size() / 3), p.x1.data());
+    add_product_rows_records(p.x1.data(), df, plan);
+  }
+
+  bool reads_direction_records() const override { return true; }
+  void add_product_rows_records(const double* dx_records, Eigen::VectorXd& df,
+                                int plan) const override {
+    const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
     for (int group : p.groups) {
       const std::size_t first = static_cast<std::size_t>(group) * L;
-      detail::group_dot_records(*batches_, group, gradient(group), record_.data(), p.x1.data(),
+      detail::group_dot_records(*batches_, group, gradient(group), record_.data(), dx_records,
                                 &factor_[first], &p.s[first]);
     }
     if (p.rows_gathered) {

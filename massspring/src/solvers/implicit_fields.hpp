@@ -105,12 +105,21 @@ class ImplicitFields {
   // Once u is final at block `block`'s lanes, before the reduction's barrier: h u at the field
   // nodes of plan `plan` there into the vector every member's next rows_product reads (each
   // member copies its own nodes once, not every node for itself).
+  // The tangents that read records (Tangent::reads_direction_records) get h u as records of four,
+  // the others as a vector: each is written only where some tangent reads it.
   void share_direction(int plan, int block, const Real* u_records, double h) {
     const auto& nodes = plan_nodes_[static_cast<std::size_t>(plan)];
     const auto& start = plan_block_start_[static_cast<std::size_t>(plan)];
-    for (auto n = nodes.begin() + start[block]; n != nodes.begin() + start[block + 1]; ++n)
-      for (int c = 0; c < 3; ++c)
-        hu_[3 * n->node + c] = h * u_records[kDirection * n->id + c];
+    const auto first = nodes.begin() + start[block], last = nodes.begin() + start[block + 1];
+    if (hu_by_records_)
+      for (auto n = first; n != last; ++n)
+        for (int c = 0; c < 3; ++c)
+          hu_records_[4 * static_cast<std::size_t>(n->node) + c] =
+              h * u_records[kDirection * n->id + c];
+    if (hu_by_vector_)
+      for (auto n = first; n != last; ++n)
+        for (int c = 0; c < 3; ++c)
+          hu_[3 * n->node + c] = h * u_records[kDirection * n->id + c];
   }
 
   // Before a product, by the member with plan `plan` (member_plan), once every member has shared
@@ -121,7 +130,10 @@ class ImplicitFields {
     for (const Node& n : plan_nodes_[static_cast<std::size_t>(plan)])
       y.template segment<3>(3 * n.node).setZero();
     for (const auto& tangent : tangents_)
-      tangent->add_product_rows(hu_, y, plan);
+      if (tangent->reads_direction_records())
+        tangent->add_product_rows_records(hu_records_.data(), y, plan);
+      else
+        tangent->add_product_rows(hu_, y, plan);
   }
 
   // Once the spring product has written w at block `block`'s lanes: w += A_F u at the plan's
@@ -315,6 +327,10 @@ class ImplicitFields {
     start_rows_ = rows_;
     for (const auto& tangent : tangents_)
       start_rows_ = start_rows_ && tangent->starts_by_rows();
+    hu_by_records_ = hu_by_vector_ = false;
+    for (const auto& tangent : tangents_)
+      (tangent->reads_direction_records() ? hu_by_records_ : hu_by_vector_) = rows_;
+    hu_records_.assign(hu_by_records_ ? static_cast<std::size_t>(4 * (dofs / 3)) : 0, 0.0);
     // Per plan and block: where the block's nodes start in the plan's (nodes are by block).
     plan_block_start_.assign(static_cast<std::size_t>(team_) + 1, {});
     for (int plan = 0; plan <= team_; ++plan) {
@@ -378,6 +394,8 @@ class ImplicitFields {
   std::vector<std::vector<Eigen::Matrix3d>> blocks_part_;
   std::vector<double> member_dots_;
   bool rows_ = false;
+  bool hu_by_records_ = false, hu_by_vector_ = false;  // rows: which forms of h u the tangents read
+  std::vector<double> hu_records_;                     // h u as records of four (x y z 0)
   bool start_rows_ = false;                         // rows, and every tangent starts a step by rows
   std::vector<std::vector<Node>> plan_nodes_;       // per plan, by block
   std::vector<std::vector<int>> plan_block_start_;  // per plan, per block + 1

@@ -172,6 +172,13 @@ class ForceField : public ForceModel {
     /// run for every part; dx must hold every one of the field's nodes.
     virtual void add_product_rows(const Eigen::VectorXd& /*dx*/, Eigen::VectorXd& /*df*/,
                                   int /*plan*/) const {}
+    /// Whether add_product_rows_records is the tangent's own product by rows (by default not): a
+    /// caller that holds the direction as records saves the tangent copying it into them.
+    virtual bool reads_direction_records() const { return false; }
+    /// add_product_rows with the direction as records of four: dx_records[4 i + c] = dx[3 i + c]
+    /// for c < 3 and 0 for c = 3, at every one of the field's nodes i.
+    virtual void add_product_rows_records(const double* /*dx_records*/, Eigen::VectorXd& /*df*/,
+                                          int /*plan*/) const {}
     /// Whether start_rows gives the start of a step (by default not: the caller takes it by
     /// parts, start_part or the calls it stands for).
     virtual bool starts_by_rows() const { return false; }
