@@ -116,6 +116,12 @@ MSFEM_ROW_CLONES void start_row_sums(const RowIncidences& rows, const int* g_at,
   }
 }
 
+void to_records(const double* x, const std::vector<int>& record_of_node, double* records) {
+  for (std::size_t i = 0; i < record_of_node.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      records[4 * static_cast<long>(record_of_node[i]) + c] = x[3 * i + c];
+}
+
 void to_records(const double* x, int nodes, double* records) {
   for (int i = 0; i < nodes; ++i)
     for (int c = 0; c < 3; ++c)
@@ -124,11 +130,12 @@ void to_records(const double* x, int nodes, double* records) {
 
 MSFEM_ROW_CLONES void group_dot_records(const VolumeBatches& b, int group, const double* g,
                                         const int* record, const double* x1, const double* factor,
-                                        double* out1) {
+                                        double scale, double* out1) {
   Double4 sum[1][kVolumeLanes / 4];
   dot_records<1>(b, group, g, record, {x1}, sum);
+  const Double4 by = broadcast(scale);
   for (int q = 0; q < kVolumeLanes / 4; ++q)
-    store4(out1 + 4 * q, load4(factor + 4 * q) * sum[0][q]);
+    store4(out1 + 4 * q, by * load4(factor + 4 * q) * sum[0][q]);
 }
 
 MSFEM_ROW_CLONES void group_dot_pair_records(const VolumeBatches& b, int group, const double* g,

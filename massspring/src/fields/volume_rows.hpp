@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 // The volume tangent's row sums (internal to the volume field): a node's row of a product is the
 // sum over the elements at the node of the element's factor times its gradient there. Each
 // incidence keeps its gradient as a four-double record (gx gy gz 0) in row order, so a row sums
@@ -35,12 +37,15 @@ void start_row_sums(const RowIncidences& rows, const int* g_at, const double* g,
 /// below: one load per node and a transpose of four, instead of three scalar loads put together
 /// lane by lane.
 void to_records(const double* x, int nodes, double* records);
+/// The same with node i's record at 4 record_of_node[i].
+void to_records(const double* x, const std::vector<int>& record_of_node, double* records);
 
 /// group_dot (volume_batches.hpp) from vectors in records: x4 at record[k·L + l] (4 × the node
-/// id, the group layout of b.offset) for node k of lane l. One vector: out1 = factor Σ g·x1.
+/// record, the group layout of b.offset) for node k of lane l. One vector: out1 = scale factor
+/// Σ g·x1.
 /// Two: also out2 = factor Σ g·x2, and base1 (where not null) added to out1.
 void group_dot_records(const VolumeBatches& b, int group, const double* g, const int* record,
-                       const double* x1, const double* factor, double* out1);
+                       const double* x1, const double* factor, double scale, double* out1);
 void group_dot_pair_records(const VolumeBatches& b, int group, const double* g, const int* record,
                             const double* x1, const double* x2, const double* factor,
                             const double* base1, double* out1, double* out2);

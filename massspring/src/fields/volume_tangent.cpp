@@ -122,8 +122,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
       p.s2.assign(scale_.size(), 0.0);
       p.g_rows.assign(4 * p.lane.size(), 0.0);
       p.row_out.assign(16 * p.rows.size(), 0.0);
-      p.x1.assign(4 * row_of.size(), 0.0);
-      p.x2.assign(4 * row_of.size(), 0.0);
+      p.x1.assign(4 * records(), 0.0);
+      p.x2.assign(4 * records(), 0.0);
     }
     return true;
   }
@@ -139,18 +139,26 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
 
   void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
-    detail::to_records(dx.data(), static_cast<int>(dx.size() / 3), p.x1.data());
-    add_product_rows_records(p.x1.data(), df, plan);
+    to_own_records(dx, p.x1);
+    add_product_rows_records(p.x1.data(), 1.0, df, plan);
   }
 
   bool reads_direction_records() const override { return true; }
-  void add_product_rows_records(const double* dx_records, Eigen::VectorXd& df,
+  void set_record_order(const std::vector<int>& record_of_node) override {
+    record_of_node_ = record_of_node;
+    set_lane_constants();
+    for (RowPlan& p : plans_) {
+      p.x1.assign(4 * records(), 0.0);
+      p.x2.assign(4 * records(), 0.0);
+    }
+  }
+  void add_product_rows_records(const double* dx_records, double scale, Eigen::VectorXd& df,
                                 int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
     for (int group : p.groups) {
       const std::size_t first = static_cast<std::size_t>(group) * L;
       detail::group_dot_records(*batches_, group, gradient(group), record_.data(), dx_records,
-                                &factor_[first], &p.s[first]);
+                                &factor_[first], scale, &p.s[first]);
     }
     if (p.rows_gathered) {
       detail::add_row_sums(incidences(p), p.s.data(), df.data());
@@ -175,8 +183,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                   Eigen::VectorXd& df2, double cx, std::vector<Eigen::Matrix3d>& blocks,
                   int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
-    detail::to_records(dx1.data(), static_cast<int>(dx1.size() / 3), p.x1.data());
-    detail::to_records(dx2.data(), static_cast<int>(dx2.size() / 3), p.x2.data());
+    to_own_records(dx1, p.x1);
+    to_own_records(dx2, p.x2);
     for (int group : p.groups) {
       const std::size_t first = static_cast<std::size_t>(group) * L;
       detail::group_dot_pair_records(*batches_, group, gradient(group), record_.data(), p.x1.data(),
@@ -229,8 +237,10 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   // fill), and each node's record in the group layout.
   void set_lane_constants() {
     record_.resize(batches_->offset.size());
-    for (std::size_t i = 0; i < record_.size(); ++i)
-      record_[i] = batches_->offset[i] / 3 * 4;
+    for (std::size_t i = 0; i < record_.size(); ++i) {
+      const int node = batches_->offset[i] / 3;
+      record_[i] = 4 * (record_of_node_.empty() ? node : record_of_node_[node]);
+    }
     const auto& elements = field_->elements_;
     const std::size_t lanes = static_cast<std::size_t>(batches_->num_groups()) * L;
     scale_.assign(lanes, 0.0);
@@ -328,6 +338,19 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     g_.assign(3 * batches_->offset.size(), 0.0);
     set_lane_constants();
   }
+  // How many records a vector takes in record_'s order.
+  std::size_t records() const {
+    if (record_of_node_.empty()) return static_cast<std::size_t>(x_->size() / 3);
+    return 1 + static_cast<std::size_t>(
+                   *std::max_element(record_of_node_.begin(), record_of_node_.end()));
+  }
+  // A vector over the model's nodes into records in record_'s order.
+  void to_own_records(const Eigen::VectorXd& dx, std::vector<double>& records) const {
+    if (record_of_node_.empty())
+      detail::to_records(dx.data(), static_cast<int>(dx.size() / 3), records.data());
+    else
+      detail::to_records(dx.data(), record_of_node_, records.data());
+  }
   double* gradient(int group) { return g_.data() + 3 * batches_->group_start[group]; }
   const double* gradient(int group) const { return g_.data() + 3 * batches_->group_start[group]; }
 
@@ -358,8 +381,9 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   std::vector<double> scale_;   // per group lane: κ/|V⁰|, 0 on lanes the group does not fill
   std::vector<double> factor_;  // per group lane: −κ/|V⁰| / 36, a product's factor on g·dx
   std::vector<double> rest_;    // per group lane: V⁰
-  std::vector<int> record_;     // per group slot (b.offset's layout): 4 × the node id
-  std::vector<double> force_;   // per group lane: κ (V − V⁰)/|V⁰| / 6 at set_part, on g
+  std::vector<int> record_;     // per group slot (b.offset's layout): 4 × the node's record
+  std::vector<int> record_of_node_;  // the caller's record order (set_record_order); empty: node
+  std::vector<double> force_;        // per group lane: κ (V − V⁰)/|V⁰| / 6 at set_part, on g
   std::vector<RowPlan> plans_;
 };
 

@@ -161,7 +161,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       while (iteration < options_.cg_max_iterations && rr > target) {
         double delta[3];  // u·A u
         if (fields_.rows())
-          fields_.rows_product(plan);
+          fields_.rows_product(plan, p_records_.data(), dt);
         else if (!fields_.empty())
           fields_.gather_direction(b0, b1, p_records_.data(), dt);
         reduced(

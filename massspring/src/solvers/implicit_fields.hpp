@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "kernels/node_gather_layout.hpp"
@@ -105,17 +106,21 @@ class ImplicitFields {
   // Once u is final at block `block`'s lanes, before the reduction's barrier: h u at the field
   // nodes of plan `plan` there into the vector every member's next rows_product reads (each
   // member copies its own nodes once, not every node for itself).
-  // The tangents that read records (Tangent::reads_direction_records) get h u as records of four,
-  // the others as a vector: each is written only where some tangent reads it.
+  // Once u is final at block `block`'s lanes, before the reduction's barrier: u at the field
+  // nodes of plan `plan` there into what every member's next rows_product reads (each member
+  // writes its own nodes once): h u into a vector for the tangents that read one; for those that
+  // read records, u into records of doubles where the stepper's own records are floats (in double
+  // they read the stepper's records themselves).
   void share_direction(int plan, int block, const Real* u_records, double h) {
     const auto& nodes = plan_nodes_[static_cast<std::size_t>(plan)];
     const auto& start = plan_block_start_[static_cast<std::size_t>(plan)];
     const auto first = nodes.begin() + start[block], last = nodes.begin() + start[block + 1];
-    if (hu_by_records_)
-      for (auto n = first; n != last; ++n)
-        for (int c = 0; c < 3; ++c)
-          hu_records_[4 * static_cast<std::size_t>(n->node) + c] =
-              h * u_records[kDirection * n->id + c];
+    if constexpr (!std::is_same_v<Real, double>)
+      if (u_by_records_)
+        for (auto n = first; n != last; ++n)
+          for (int c = 0; c < 3; ++c)
+            u_records_[kDirection * static_cast<std::size_t>(n->id) + c] =
+                u_records[kDirection * n->id + c];
     if (hu_by_vector_)
       for (auto n = first; n != last; ++n)
         for (int c = 0; c < 3; ++c)
@@ -125,13 +130,18 @@ class ImplicitFields {
   // Before a product, by the member with plan `plan` (member_plan), once every member has shared
   // its h u (share_direction) and passed the barrier: the fields' rows -A_F u / h = K_F (h u) at
   // its nodes.
-  void rows_product(int plan) {
+  void rows_product(int plan, const Real* u_records, double h) {
     Eigen::VectorXd& y = plan_y_[static_cast<std::size_t>(plan)];
     for (const Node& n : plan_nodes_[static_cast<std::size_t>(plan)])
       y.template segment<3>(3 * n.node).setZero();
+    const double* records;
+    if constexpr (std::is_same_v<Real, double>)
+      records = u_records;
+    else
+      records = u_records_.data();
     for (const auto& tangent : tangents_)
       if (tangent->reads_direction_records())
-        tangent->add_product_rows_records(hu_records_.data(), y, plan);
+        tangent->add_product_rows_records(records, h, y, plan);
       else
         tangent->add_product_rows(hu_, y, plan);
   }
@@ -327,10 +337,17 @@ class ImplicitFields {
     start_rows_ = rows_;
     for (const auto& tangent : tangents_)
       start_rows_ = start_rows_ && tangent->starts_by_rows();
-    hu_by_records_ = hu_by_vector_ = false;
+    // The tangents that read the direction as records read it in the stepper's record order.
+    u_by_records_ = hu_by_vector_ = false;
     for (const auto& tangent : tangents_)
-      (tangent->reads_direction_records() ? hu_by_records_ : hu_by_vector_) = rows_;
-    hu_records_.assign(hu_by_records_ ? static_cast<std::size_t>(4 * (dofs / 3)) : 0, 0.0);
+      (tangent->reads_direction_records() ? u_by_records_ : hu_by_vector_) = rows_;
+    if (u_by_records_)
+      for (const auto& tangent : tangents_)
+        if (tangent->reads_direction_records()) tangent->set_record_order(soa_->new_id);
+    u_records_.assign(u_by_records_ && !std::is_same_v<Real, double>
+                          ? kDirection * static_cast<std::size_t>(soa_->num_nodes + 2)
+                          : 0,
+                      0.0);
     // Per plan and block: where the block's nodes start in the plan's (nodes are by block).
     plan_block_start_.assign(static_cast<std::size_t>(team_) + 1, {});
     for (int plan = 0; plan <= team_; ++plan) {
@@ -394,9 +411,9 @@ class ImplicitFields {
   std::vector<std::vector<Eigen::Matrix3d>> blocks_part_;
   std::vector<double> member_dots_;
   bool rows_ = false;
-  bool hu_by_records_ = false, hu_by_vector_ = false;  // rows: which forms of h u the tangents read
-  std::vector<double> hu_records_;                     // h u as records of four (x y z 0)
-  bool start_rows_ = false;                         // rows, and every tangent starts a step by rows
+  bool u_by_records_ = false, hu_by_vector_ = false;  // rows: which forms of u the tangents read
+  std::vector<double> u_records_;  // float steppers: u in double records, the stepper's order
+  bool start_rows_ = false;        // rows, and every tangent starts a step by rows
   std::vector<std::vector<Node>> plan_nodes_;       // per plan, by block
   std::vector<std::vector<int>> plan_block_start_;  // per plan, per block + 1
   std::vector<Eigen::VectorXd> plan_u_, plan_y_;    // per plan: h u at every field node, its rows

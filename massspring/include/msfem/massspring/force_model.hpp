@@ -172,13 +172,17 @@ class ForceField : public ForceModel {
     /// run for every part; dx must hold every one of the field's nodes.
     virtual void add_product_rows(const Eigen::VectorXd& /*dx*/, Eigen::VectorXd& /*df*/,
                                   int /*plan*/) const {}
-    /// Whether add_product_rows_records is the tangent's own product by rows (by default not): a
-    /// caller that holds the direction as records saves the tangent copying it into them.
+    /// Whether the tangent's product by rows can read the direction from the caller's own
+    /// records (add_product_rows_records; by default not): a caller that holds it so saves the
+    /// tangent a copy of the whole direction before each product.
     virtual bool reads_direction_records() const { return false; }
-    /// add_product_rows with the direction as records of four: dx_records[4 i + c] = dx[3 i + c]
-    /// for c < 3 and 0 for c = 3, at every one of the field's nodes i.
-    virtual void add_product_rows_records(const double* /*dx_records*/, Eigen::VectorXd& /*df*/,
-                                          int /*plan*/) const {}
+    /// Node i's record in the records add_product_rows_records reads starts at
+    /// 4 record_of_node[i] (x y z, then one value it does not read). Called after plan_rows.
+    virtual void set_record_order(const std::vector<int>& /*record_of_node*/) {}
+    /// df += scale (∂f/∂x) dx at the rows of plan `plan`, as add_product_rows, with
+    /// dx[3 i + c] = dx_records[4 record_of_node[i] + c] at every one of the field's nodes i.
+    virtual void add_product_rows_records(const double* /*dx_records*/, double /*scale*/,
+                                          Eigen::VectorXd& /*df*/, int /*plan*/) const {}
     /// Whether start_rows gives the start of a step (by default not: the caller takes it by
     /// parts, start_part or the calls it stands for).
     virtual bool starts_by_rows() const { return false; }
