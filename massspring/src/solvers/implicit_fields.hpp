@@ -103,9 +103,6 @@ class ImplicitFields {
     plan_rows(member_block, 3 * static_cast<Eigen::Index>(soa_->num_nodes));
   }
 
-  // Once u is final at block `block`'s lanes, before the reduction's barrier: h u at the field
-  // nodes of plan `plan` there into the vector every member's next rows_product reads (each
-  // member copies its own nodes once, not every node for itself).
   // Once u is final at block `block`'s lanes, before the reduction's barrier: u at the field
   // nodes of plan `plan` there into what every member's next rows_product reads (each member
   // writes its own nodes once): h u into a vector for the tangents that read one; for those that
@@ -128,8 +125,8 @@ class ImplicitFields {
   }
 
   // Before a product, by the member with plan `plan` (member_plan), once every member has shared
-  // its h u (share_direction) and passed the barrier: the fields' rows -A_F u / h = K_F (h u) at
-  // its nodes.
+  // its u (share_direction) and passed the barrier: the fields' rows -A_F u / h = K_F (h u) at
+  // its nodes, from `u_records` (the stepper's) or the shares.
   void rows_product(int plan, const Real* u_records, double h) {
     Eigen::VectorXd& y = plan_y_[static_cast<std::size_t>(plan)];
     for (const Node& n : plan_nodes_[static_cast<std::size_t>(plan)])
