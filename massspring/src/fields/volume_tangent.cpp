@@ -146,7 +146,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
   bool reads_direction_records() const override { return true; }
   void set_record_order(const std::vector<int>& record_of_node) override {
     record_of_node_ = record_of_node;
-    set_lane_constants();
+    set_records();
     for (RowPlan& p : plans_) {
       p.x1.assign(4 * records(), 0.0);
       p.x2.assign(4 * records(), 0.0);
@@ -233,14 +233,19 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     }
   }
 
-  // What does not change with the state, per group lane (scale 0 on the lanes a group does not
-  // fill), and each node's record in the group layout.
-  void set_lane_constants() {
+  // Each group slot's record in the records the products read (record_of_node_'s order).
+  void set_records() {
     record_.resize(batches_->offset.size());
     for (std::size_t i = 0; i < record_.size(); ++i) {
       const int node = batches_->offset[i] / 3;
       record_[i] = 4 * (record_of_node_.empty() ? node : record_of_node_[node]);
     }
+  }
+
+  // What does not change with the state, per group lane (scale 0 on the lanes a group does not
+  // fill), and each node's record in the group layout.
+  void set_lane_constants() {
+    set_records();
     const auto& elements = field_->elements_;
     const std::size_t lanes = static_cast<std::size_t>(batches_->num_groups()) * L;
     scale_.assign(lanes, 0.0);
