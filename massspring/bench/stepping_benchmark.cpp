@@ -174,36 +174,64 @@ State loaded_start(const MassSpringModel& model) {
   return start;
 }
 
-PrecisionComparison compare_precision(const MassSpringModel& model, double dt, int steps,
-                                      int threads) {
+namespace {
+
+// The largest distance between a node's positions in two states.
+double farthest(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < a.size(); i += 3)
+    largest = std::max(largest, (a - b).segment<3>(i).norm());
+  return largest;
+}
+
+// Steps the two steppers side by side from the loaded start, `every` steps between checkpoints.
+template <class Stepper>
+PrecisionComparison compare_side_by_side(const MassSpringModel& model, Stepper& exact,
+                                         Stepper& single, int steps, int every,
+                                         const std::function<void(Stepper&, int)>& advance) {
   const State start = loaded_start(model);
   const Eigen::VectorXd rest = initial_state(model).x;
-  FastStepperOptions options;
-  options.threads = threads;
-  FastExplicitStepper exact(model, options);
-  options.single_precision = true;
-  FastExplicitStepper single(model, options);
   exact.set_state(start);
   single.set_state(start);
-  // The largest distance between a node's positions in two states.
-  const auto farthest = [](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-    double largest = 0.0;
-    for (Eigen::Index i = 0; i < a.size(); i += 3)
-      largest = std::max(largest, (a - b).segment<3>(i).norm());
-    return largest;
-  };
   PrecisionComparison c;
   c.max_displacement_m = farthest(start.x, rest);
   for (c.steps = 0; c.steps < steps;) {
-    const int n = std::min(100, steps - c.steps);
-    exact.step(dt, n);
-    single.step(dt, n);
+    const int n = std::min(every, steps - c.steps);
+    advance(exact, n);
+    advance(single, n);
     c.steps += n;
     const Eigen::VectorXd x = exact.state().x;
     c.max_node_error_m = std::max(c.max_node_error_m, farthest(x, single.state().x));
     c.max_displacement_m = std::max(c.max_displacement_m, farthest(x, rest));
   }
   return c;
+}
+
+}  // namespace
+
+PrecisionComparison compare_precision(const MassSpringModel& model, double dt, int steps,
+                                      int threads) {
+  FastStepperOptions options;
+  options.threads = threads;
+  FastExplicitStepper exact(model, options);
+  options.single_precision = true;
+  FastExplicitStepper single(model, options);
+  return compare_side_by_side<FastExplicitStepper>(
+      model, exact, single, steps, 100, [dt](FastExplicitStepper& s, int n) { s.step(dt, n); });
+}
+
+PrecisionComparison compare_implicit_precision(const MassSpringModel& model,
+                                               const FastImplicitOptions& options, double dt,
+                                               int steps) {
+  FastImplicitOptions in_double = options, in_float = options;
+  in_double.single_precision = false;
+  in_float.single_precision = true;
+  FastImplicitStepper exact(model, in_double), single(model, in_float);
+  return compare_side_by_side<FastImplicitStepper>(model, exact, single, steps, 10,
+                                                   [dt](FastImplicitStepper& s, int n) {
+                                                     for (int k = 0; k < n; ++k)
+                                                       s.step(dt);
+                                                   });
 }
 
 namespace {
@@ -230,6 +258,33 @@ void time_other_integrators(const MassSpringModel& model, const State& start,
     (rk4 ? result.rk4_spread : result.explicit_euler_spread) =
         rate_spread([&](int n) { stepper.step(dt, n); }, options.steps_per_call, options);
   }
+}
+
+struct ImplicitTiming {
+  RateSpread spread;
+  double mean_cg_iterations = 0.0;
+  bool single_precision_terms = false;
+};
+
+ImplicitTiming time_implicit(const MassSpringModel& model, const State& start,
+                             const FastImplicitOptions& implicit_options,
+                             const SteppingBenchmarkOptions& options) {
+  FastImplicitStepper implicit(model, implicit_options);
+  implicit.set_state(start);
+  long iterations = 0, steps = 0;
+  ImplicitTiming timed;
+  timed.spread = rate_spread(
+      [&](int n) {
+        for (int k = 0; k < n; ++k) {
+          implicit.step(options.implicit_dt);
+          iterations += implicit.last_cg_iterations();
+          ++steps;
+        }
+      },
+      1, options);
+  timed.mean_cg_iterations = static_cast<double>(iterations) / std::max(steps, 1L);
+  timed.single_precision_terms = implicit.single_precision_terms();
+  return timed;
 }
 
 }  // namespace
@@ -283,21 +338,20 @@ SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
     implicit_options.cg_tolerance = options.implicit_cg_tolerance;
     implicit_options.cg_max_iterations = options.implicit_cg_max_iterations;
     implicit_options.single_precision = options.single_precision;
-    FastImplicitStepper implicit(model, implicit_options);
-    implicit.set_state(start);
-    long iterations = 0, steps = 0;
-    result.implicit_spread = rate_spread(
-        [&](int n) {
-          for (int k = 0; k < n; ++k) {
-            implicit.step(options.implicit_dt);
-            iterations += implicit.last_cg_iterations();
-            ++steps;
-          }
-        },
-        1, options);
-    result.implicit_steps_per_second = result.implicit_spread.median;
-    result.implicit_mean_cg_iterations = static_cast<double>(iterations) / std::max(steps, 1L);
-    result.implicit_single_precision_terms = implicit.single_precision_terms();
+    const ImplicitTiming timed = time_implicit(model, start, implicit_options, options);
+    result.implicit_spread = timed.spread;
+    result.implicit_steps_per_second = timed.spread.median;
+    result.implicit_mean_cg_iterations = timed.mean_cg_iterations;
+    result.implicit_single_precision_terms = timed.single_precision_terms;
+    if (options.run_implicit_float && !options.single_precision) {
+      implicit_options.single_precision = true;
+      const ImplicitTiming in_float = time_implicit(model, start, implicit_options, options);
+      result.implicit_float_spread = in_float.spread;
+      result.implicit_float_steps_per_second = in_float.spread.median;
+      result.implicit_float_mean_cg_iterations = in_float.mean_cg_iterations;
+      result.implicit_float_vs_double = compare_implicit_precision(
+          model, implicit_options, options.implicit_dt, options.implicit_precision_steps);
+    }
   }
   if (options.compare_precision)
     result.float_vs_double =

@@ -240,6 +240,36 @@ TEST(FastImplicitStepper, MatchesBackwardEuler) {
   EXPECT_LE(haptic.last_cg_iterations(), 50);
 }
 
+// The float implicit stepper's records hold displacements, as the explicit one's do: a sphere a
+// metre and a half from the origin sags under gravity (float positions there are good to 1e-7 m,
+// a tenth of a millimetre spring's length per thousand), and float follows double to 1e-6 of the
+// sag (measured 1.8e-7; with absolute float positions 2.2e-5).
+TEST(FastImplicitStepper, FloatKeepsASagFarFromTheOrigin) {
+  auto mesh = testing::icosphere(2, 0.05);
+  mesh.vertices.rowwise() += Eigen::RowVector3d(0.9, -0.7, 1.1);
+  ThreeTierOptions tiers;
+  tiers.material.spring_damping = 0.05;
+  MassSpringModel model(build_three_tier(mesh.vertices, mesh.triangles, tiers));
+  model.set_gravity({0.0, 0.0, -9.81});
+  FastImplicitOptions in_double;
+  in_double.cg_tolerance = 1e-5;
+  in_double.cg_max_iterations = 200;
+  FastImplicitOptions in_float = in_double;
+  in_float.single_precision = true;
+  FastImplicitStepper exact(model, in_double), single(model, in_float);
+  double worst = 0.0, largest = 0.0;
+  for (int checkpoint = 0; checkpoint < 10; ++checkpoint) {
+    exact.step(1e-3, 20);
+    single.step(1e-3, 20);
+    const Eigen::VectorXd x = exact.state().x;
+    worst = std::max(worst, (single.state().x - x).cwiseAbs().maxCoeff());
+    largest = std::max(largest, (x - model.rest_state()).cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(largest, 1e-4);  // a sag, not rest
+  EXPECT_LT(largest, 2e-2);
+  EXPECT_LT(worst, 1e-6 * largest);
+}
+
 // A loose double solve keeps the springs' coefficients in float: the operator is the double one
 // rounded per coefficient (6e-8), so its solves to 1e-6 stay as close to the tight solve as the
 // all-double ones (measured: both 1.9e-8 of the displacement after 30 steps) and part from them by
@@ -334,7 +364,7 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   EXPECT_GT(result.implicit_steps_per_second, 0.0);
   for (const RateSpread* s :
        {&result.explicit_spread, &result.naive_spread, &result.implicit_spread,
-        &result.explicit_euler_spread, &result.rk4_spread}) {
+        &result.explicit_euler_spread, &result.rk4_spread, &result.implicit_float_spread}) {
     EXPECT_GT(s->min, 0.0);
     EXPECT_LE(s->min, s->median);
     EXPECT_LE(s->median, s->max);
@@ -342,6 +372,10 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   EXPECT_EQ(result.explicit_spread.median, result.explicit_steps_per_second);
   ASSERT_TRUE(result.float_vs_double);
   EXPECT_EQ(result.float_vs_double->steps, 1000);
+  EXPECT_EQ(result.implicit_float_spread.median, result.implicit_float_steps_per_second);
+  EXPECT_GT(result.implicit_float_mean_cg_iterations, 0.0);
+  ASSERT_TRUE(result.implicit_float_vs_double);
+  EXPECT_EQ(result.implicit_float_vs_double->steps, 100);
   // At least the records read and written (8 doubles a node) and k, k l0 of both ends of every
   // spring; padding makes it more, but not twice more.
   const std::size_t least = 2 * 8 * sizeof(double) * 486 + 2 * 2 * sizeof(double) * result.springs;
@@ -371,6 +405,19 @@ TEST(SteppingBenchmark, TimesEachIntegratorAtTheStepACaseGives) {
   EXPECT_EQ(chosen.rk4_dt, 0.7 * rule);
   EXPECT_EQ(chosen.precision_dt, rule);  // float against double keeps the bench's own step
   EXPECT_GT(chosen.rk4_spread.median, 0.0);
+}
+
+// The implicit stepper in float against double, both at the haptic tolerance, over 100 steps of
+// 1 ms from the dilated sphere: within 1e-5 of the largest displacement (measured 2.2e-7), far
+// below what the tolerance itself moves either from the tight solve (2e-3,
+// HapticToleranceStaysCloseToTheTightSolve).
+TEST(SteppingBenchmark, FloatImplicitFollowsDoubleOnALoadedRun) {
+  const MassSpringModel model = loaded_three_tier();
+  const PrecisionComparison c = compare_implicit_precision(model, FastImplicitOptions{}, 1e-3, 100);
+  EXPECT_EQ(c.steps, 100);
+  EXPECT_GT(c.max_displacement_m, 1e-4);
+  EXPECT_GT(c.max_node_error_m, 0.0);  // two precisions, not one stepper twice
+  EXPECT_LT(c.relative(), 1e-5);
 }
 
 TEST(SteppingBenchmark, StreamTriadMeasuresABandwidth) {

@@ -5,7 +5,7 @@
 // CSR incidence of springs on free nodes, and the per-node constant terms (loads, anchors,
 // damping). The steppers' node-centric layout (node_gather_layout.hpp) is built from it.
 //
-// Relative layouts (the float explicit stepper) hold each node's displacement from a rest frame
+// Relative layouts (both fast steppers in float) hold each node's displacement from a rest frame
 // instead of its position: float positions of a 0.1 m organ are good to 4e-9 m, a millimetre
 // spring's length then to 4e-6 of itself, and a step's update x += h v loses its low bits to the
 // coordinate's magnitude; a displacement keeps float's relative precision. The frame is the

@@ -43,7 +43,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         options_(options),
         team_(std::max(options.threads, 1)),
         threads_(team_.size(), options.adaptive_threads),
-        soa_(model, options.reorder_nodes),
+        soa_(model, options.reorder_nodes, kRelative),
         gather_(soa_),
         records_(kRecord * (soa_.num_nodes + 2)),
         p_records_(detail::kDirection * (soa_.num_nodes + 2)),
@@ -91,7 +91,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     State out{Eigen::VectorXd(3 * soa_.num_nodes), Eigen::VectorXd(3 * soa_.num_nodes), time_};
     for (int i = 0; i < soa_.num_nodes; ++i)
       for (int c = 0; c < 3; ++c) {
-        out.x[3 * soa_.order[i] + c] = records_[kRecord * i + c];
+        out.x[3 * soa_.order[i] + c] = soa_.frame_at(c, i) + records_[kRecord * i + c];
         out.v[3 * soa_.order[i] + c] = records_[kRecord * i + 3 + c];
       }
     return out;
@@ -298,6 +298,11 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         soa_.v[c][i] = records_[kRecord * i + 3 + c];
       }
   }
+
+  // Float records hold displacements from a rest frame, as the explicit stepper's do
+  // (soa_layout.hpp): from float positions a millimetre spring's force carries 4e-6 of its
+  // length in noise each step, which the warm-started CG then chases.
+  static constexpr bool kRelative = std::is_same_v<Real, float>;
 
   const MechanicalSystem* model_;
   FastImplicitOptions options_;

@@ -169,7 +169,7 @@ class ImplicitFields {
     for (const Node& n : owned(b0, b1)) {
       for (int c = 0; c < 3; ++c) {
         const Eigen::Index k = 3 * n.node + c;
-        x_[k] = records[kRecord * n.id + c];
+        x_[k] = soa_->frame_at(c, n.id) + records[kRecord * n.id + c];
         v_[k] = records[kRecord * n.id + 3 + c];
         dv_[k] = dv_records[kDirection * n.id + c];
         hv_[k] = h * v_[k];

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "msfem/massspring/fast_implicit_stepper.hpp"
 #include "msfem/massspring/integrators.hpp"
 #include "msfem/massspring/mass_spring_model.hpp"
 
@@ -63,6 +64,10 @@ struct SteppingBenchmarkOptions {
   int implicit_cg_max_iterations = 50;
   bool compare_precision = true;  ///< run float against double (PrecisionComparison)
   int precision_steps = 1000;
+  /// Where the implicit stepper runs in double, also time it in float and compare the two over
+  /// implicit_precision_steps steps of implicit_dt (a haptic loop's tenth of a second).
+  bool run_implicit_float = true;
+  int implicit_precision_steps = 100;
 };
 
 /// Steps per second over a figure's samples: a spread as wide as the median says the machine, the
@@ -102,7 +107,12 @@ struct SteppingBenchmarkResult {
   int explicit_last_step_threads = 0;  ///< where adaptive threads ended (1 or threads)  ///<
                                        ///< FastExplicitStepper::streamed_bytes_per_step
   std::optional<PrecisionComparison> float_vs_double;  ///< when options.compare_precision
-  std::vector<std::string> notes;                      ///< figures not taken, and why
+  /// The implicit stepper in float beside the double one (options.run_implicit_float).
+  double implicit_float_steps_per_second = 0.0;
+  double implicit_float_mean_cg_iterations = 0.0;
+  RateSpread implicit_float_spread;
+  std::optional<PrecisionComparison> implicit_float_vs_double;
+  std::vector<std::string> notes;  ///< figures not taken, and why
 };
 
 /// Measures steps per second of the explicit fast stepper, the naive loop and the implicit fast
@@ -140,6 +150,12 @@ State loaded_start(const MassSpringModel& model);
 /// 100 steps.
 PrecisionComparison compare_precision(const MassSpringModel& model, double dt, int steps,
                                       int threads);
+
+/// Float against double on the fast implicit stepper, both with `options` otherwise (its CG
+/// tolerance included, so the figure holds what a loose solve adds), checkpoints every 10 steps.
+PrecisionComparison compare_implicit_precision(const MassSpringModel& model,
+                                               const FastImplicitOptions& options, double dt,
+                                               int steps);
 
 SteppingBenchmarkResult run_stepping_benchmark(const MassSpringModel& model,
                                                const SteppingBenchmarkOptions& options = {});
