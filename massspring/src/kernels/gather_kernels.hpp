@@ -82,6 +82,7 @@ struct PortableLanes {
   static MSFEM_INLINE V sqrt(V a) {
     return map([&](int l) { return std::sqrt(a.v[l]); });
   }
+  static MSFEM_INLINE V sqrt_to_float(V a) { return sqrt(a); }
   static MSFEM_INLINE V inverse_sqrt(V a) {
     return map([&](int l) { return R(1) / std::sqrt(a.v[l]); });
   }
