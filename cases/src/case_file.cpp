@@ -237,6 +237,10 @@ void declare_fem_timing_output(ParameterHandler& prm) {
   prm.declare_entry(
       "steps", "2000", Patterns::Integer(1, 100000000),
       "Dynamic steps timed, at least (five samples of a fifth of them and of 0.1 s each).");
+  prm.declare_entry("precision", "double", Patterns::Selection("double|float"),
+                    "Arithmetic of the fast steppers timed (and of msfem haptic's model thread): "
+                    "double, or float (twice the vector lanes; positions kept as displacements "
+                    "from the rest shape).");
   prm.leave_subsection();
   prm.enter_subsection("output");
   prm.declare_entry("directory", default_output_directory, Patterns::Anything(),
@@ -485,7 +489,7 @@ void extract_fem_timing_output(ParameterHandler& prm, CaseParameters& c) {
   prm.leave_subsection();
   prm.enter_subsection("timing");
   c.timing = {setting<massspring::IntegratorKind>(prm, "integrator"), prm.get_double("dt"),
-              static_cast<int>(prm.get_integer("steps"))};
+              static_cast<int>(prm.get_integer("steps")), prm.get("precision") == "float"};
   prm.leave_subsection();
   prm.enter_subsection("output");
   c.output.directory = prm.get("directory");

@@ -167,6 +167,18 @@ TEST_F(CaseFile, EveryIntegratorMassspringKnowsAndNoOther) {
   EXPECT_NE(error.find("verlet"), std::string::npos) << error;
 }
 
+// timing/precision: double unless float is asked for; anything else is refused naming the key.
+TEST_F(CaseFile, TimingPrecisionIsDoubleOrFloat) {
+  const auto p = write("c.prm", "subsection timing\n  set integrator = implicit_euler\nend\n");
+  EXPECT_FALSE(read_case(p).timing.single_precision);
+  EXPECT_TRUE(read_case(p, {"timing/precision=float"}).timing.single_precision);
+  EXPECT_FALSE(read_case(p, {"timing/precision=double"}).timing.single_precision);
+  const auto bad = write("bad.prm", "subsection timing\n  set precision = half\nend\n");
+  const std::string error = error_of(bad);
+  EXPECT_NE(error.find("bad.prm:2"), std::string::npos) << error;
+  EXPECT_NE(error.find("half"), std::string::npos) << error;
+}
+
 TEST_F(CaseFile, ErrorEstimateMethodsAndTheirLimits) {
   const auto p = write("c.prm", "subsection fem\n  set degree = 1\nend\n");
   EXPECT_EQ(read_case(p).fem.error_estimate, FemParameters::ErrorEstimate::automatic);

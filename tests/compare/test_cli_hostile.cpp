@@ -109,6 +109,7 @@ const Hostile hostile[] = {
      "support/fixed region"},
     {"UnknownIntegrator", "run " + sphere_indent_case + " --set 'timing/integrator=verlet'",
      "verlet"},
+    {"UnknownPrecision", "run " + sphere_indent_case + " --set 'timing/precision=half'", "half"},
     {"PathStepThatWouldPressForever",
      "run " + sphere_indent_case + " --set 'loads/tool/path step=1e-9'", "loads/tool/path step"},
     {"ErrorEstimateDegreeAtP2", "run " + sphere_indent_case + " --set 'fem/error estimate=degree'",

@@ -197,6 +197,7 @@ TEST(HapticReplay, RendersTheModelsForceAndShowsAChangeAtItsTime) {
   ASSERT_EQ(json["variants"].size(), 1u);
   const auto& v = json["variants"][0];
   EXPECT_EQ(v["name"], "three_tier");
+  EXPECT_EQ(v["precision"], "double");
   EXPECT_EQ(v["ticks"], 2501);
   EXPECT_LE(v["step_ms"]["p50"].get<double>(), v["step_ms"]["p99"].get<double>());
   EXPECT_LE(v["step_ms"]["p99"].get<double>(), v["step_ms"]["max"].get<double>());
@@ -260,6 +261,42 @@ TEST(HapticReplay, RendersTheModelsForceAndShowsAChangeAtItsTime) {
       EXPECT_NEAR(s["static_force_n"][2].get<double>(), run_variant, 1e-3 * std::abs(run_variant));
       EXPECT_NEAR(s["force_n"][2].get<double>(), run_variant, 0.05 * std::abs(run_variant));
     }
+  }
+  EXPECT_GE(held, 4);
+}
+
+// timing/precision = float: the model thread steps in float, and with the tool pressed 4 mm and
+// held the force it renders is the variant's static force there (the double solve's) as closely
+// as the double model's is in RendersTheModelsForceAndShowsAChangeAtItsTime.
+TEST(HapticReplay, AFloatModelRendersTheHeldForce) {
+  TemporaryDirectory dir;
+  const compare::Problem problem = compare::make_problem(cases::read_case(case_file, small));
+  const compare::ToolPlacement& tool = problem.tools.front();
+  const Eigen::Vector3d n = tool.outward_normal, above = tool.contact_point + 0.006 * n;
+  const Eigen::Vector3d pressed = tool.contact_point + (tool.radius - 0.004) * n;
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "t_s,x_m,y_m,z_m\n0," << above.x() << ',' << above.y() << ',' << above.z() << '\n';
+  for (double t : {0.3, 3.0})
+    csv << t << ',' << pressed.x() << ',' << pressed.y() << ',' << pressed.z() << '\n';
+  const auto path = write(dir / "press.csv", csv.str());
+  const auto out = dir / "haptic";
+  const auto r =
+      run_msfem("haptic " + case_file + small_options() + " --set timing/precision=float --path " +
+                path.string() + " --seconds 1 --quiet --json --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto json = nlohmann::json::parse(r.out);
+  ASSERT_EQ(json["variants"].size(), 1u);
+  const auto& v = json["variants"][0];
+  EXPECT_EQ(v["precision"], "float");
+  EXPECT_EQ(v["stepper"], "fast_implicit");
+  int held = 0;
+  for (const auto& s : v["force_error_along_path"]["samples"]) {
+    if (s["t_s"].get<double>() < 0.35) continue;
+    ++held;
+    const double static_force = s["static_force_n"][2].get<double>();
+    EXPECT_NEAR(s["force_n"][2].get<double>(), static_force, 0.05 * std::abs(static_force))
+        << s.dump();
   }
   EXPECT_GE(held, 4);
 }

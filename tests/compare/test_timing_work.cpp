@@ -98,6 +98,27 @@ TEST(TimingWork, SettlingEndsAtTheEquilibriumOrOnceTheRunStopsApproachingIt) {
   EXPECT_FALSE(stalled.settled);
   EXPECT_GT(stalled.settle_distance, 0.9);
   EXPECT_LT(stalled.settle_time_s, 10.0);
+  EXPECT_EQ(reached.precision, "double");
+}
+
+// timing/precision = float times the fast steppers in float: implicit Euler in float settles the
+// sagging sphere to the double static equilibrium, within the settle criterion's 1 %.
+TEST(TimingWork, FloatStepsSettleToTheDoubleEquilibrium) {
+  const cases::CaseParameters parameters = cases::read_case(
+      std::string(MSFEM_CASES_DIR) + "/sphere_indent.prm",
+      {"loads/tool/enabled=false", "loads/gravity=0,0,-9.81", "timing/integrator=implicit_euler",
+       "timing/precision=float", "timing/steps=50"});
+  ASSERT_TRUE(parameters.timing.single_precision);
+  const Problem problem = make_problem(parameters);
+  const BuiltVariant variant =
+      build_variant(cases::Variant::single_layer, problem, {}, std::nullopt);
+  const StaticSolution equilibrium = solve_variant_static(variant, Eigen::VectorXd());
+  const Timing t = time_variant(variant, parameters.timing, equilibrium.x);
+  EXPECT_EQ(t.stepper, "fast_implicit");
+  EXPECT_EQ(t.precision, "float");
+  EXPECT_TRUE(t.settled);
+  EXPECT_LE(t.settle_distance, 0.01);
+  EXPECT_GT(t.steps_per_second, 0.0);
 }
 
 }  // namespace

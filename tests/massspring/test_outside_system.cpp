@@ -253,6 +253,42 @@ TEST(OutsideSystem, MakeStepperPicksWhatASimulatorRuns) {
     rk4.step(loose, s, 1e-3);
   ASSERT_GT(s.x.norm(), 0.0);
   EXPECT_EQ(generic->state().x, s.x);
+  EXPECT_STREQ(generic->precision(), "double");
+  // Single precision is the fast steppers' alone: asked of the generic integrator, refused.
+  EXPECT_THROW(make_stepper(loose, IntegratorKind::rk4, initial_state(loose), {0, true}),
+               ModelError);
+}
+
+// StepperChoice::single_precision steps the fast steppers in float: each steps as the float
+// stepper it stands for, and says so.
+TEST(OutsideSystem, MakeStepperStepsInFloatWhereAsked) {
+  const Pair p = pair();
+  const State start = initial_state(*p.model);
+  const auto backward = make_stepper(*p.outside, IntegratorKind::implicit_euler, start, {1, true});
+  const auto leapfrog =
+      make_stepper(*p.outside, IntegratorKind::central_difference, start, {1, true});
+  EXPECT_STREQ(backward->precision(), "float");
+  EXPECT_STREQ(leapfrog->precision(), "float");
+  FastImplicitOptions implicit_float{1};
+  implicit_float.single_precision = true;
+  FastImplicitStepper fast(*p.outside, implicit_float);
+  FastImplicitStepper in_double(*p.outside, FastImplicitOptions{1});
+  EXPECT_STREQ(in_double.precision(), "double");
+  fast.set_state(start);
+  in_double.set_state(start);
+  backward->step(1e-3, 3);
+  fast.step(1e-3, 3);
+  in_double.step(1e-3, 3);
+  EXPECT_EQ(backward->state().x, fast.state().x);
+  EXPECT_NE(backward->state().x, in_double.state().x);  // float, not double rounded afterwards
+  FastStepperOptions explicit_float;
+  explicit_float.threads = 1;
+  explicit_float.single_precision = true;
+  FastExplicitStepper symplectic(*p.outside, explicit_float);
+  symplectic.set_state(start);
+  leapfrog->step(2e-5, 50);
+  symplectic.step(2e-5, 50);
+  EXPECT_EQ(leapfrog->state().x, symplectic.state().x);
 }
 
 }  // namespace

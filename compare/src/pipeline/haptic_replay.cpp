@@ -332,9 +332,11 @@ HapticReplay replay_once(BuiltVariant& variant, const cases::CaseParameters& par
   model.set_field<ms::ToolContact>(contact);
   const int cores = static_cast<int>(std::max(2u, std::thread::hardware_concurrency()));
   out.model_threads = settings.model_threads > 0 ? settings.model_threads : std::min(2, cores - 1);
-  const auto stepper = ms::make_stepper(model, parameters.timing.integrator,
-                                        ms::initial_state(model), {out.model_threads});
+  const auto stepper =
+      ms::make_stepper(model, parameters.timing.integrator, ms::initial_state(model),
+                       {out.model_threads, parameters.timing.single_precision});
   out.stepper = stepper->name();
+  out.precision = stepper->precision();
 
   Shared shared;
   shared.device.store(path.at(path.start()));

@@ -74,6 +74,7 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
   pt.variant = v.name;
   pt.integrator = massspring::to_string(integrator);
   pt.stepper = t.stepper;
+  pt.precision = t.precision;
   pt.volume_preservation = v.parameters.volume_preservation.has_value();
   if (run.problem.local_refinement) pt.contact_edge_m = run.problem.local_refinement->edge_m;
   pt.resolution = resolution;
@@ -95,7 +96,8 @@ SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVa
 
 template <typename Io, typename P>
 void point_fields(Io& io, P& p) {  // SweepPoint
-  io.io(p.variant), io.io(p.integrator), io.io(p.stepper), io.io(p.volume_preservation);
+  io.io(p.variant), io.io(p.integrator), io.io(p.stepper), io.io(p.precision);
+  io.io(p.volume_preservation);
   io.io(p.contact_edge_m), io.io(p.resolution), io.io(p.surface_vertices), io.io(p.nodes);
   io.io(p.springs), io.io(p.rel_l2_error), io.io(p.reaction_force_rel_error);
   io.io(p.stable_dt_s), io.io(p.steps_per_second), io.io(p.realtime_factor), io.io(p.dt_s);

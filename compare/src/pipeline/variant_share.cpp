@@ -48,7 +48,8 @@ void warning_fields(Io& io, W& w) {  // Warning
 
 template <typename Io, typename T>
 void timing_fields(Io& io, T& t) {
-  io.io(t.integrator), io.io(t.stepper), io.io(t.dt_s), io.io(t.steps_per_second);
+  io.io(t.integrator), io.io(t.stepper), io.io(t.precision), io.io(t.dt_s);
+  io.io(t.steps_per_second);
   io.io(t.stable_dt_s), io.io(t.predicted_stable_dt_s), io.io(t.realtime_factor);
   io.io(t.settle_time_s), io.io(t.settled), io.io(t.settle_distance);
   io.io(t.ms_per_60hz_frame);

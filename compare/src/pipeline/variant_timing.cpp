@@ -122,13 +122,15 @@ Timing time_variant(const BuiltVariant& variant, const cases::TimingParameters& 
   // diverge at half that step. Such a step bounds the timed code's stable step: halve and retry.
   for (int attempt = 0;; ++attempt) {
     try {
-      const auto stepper = ms::make_stepper(model, kind, start, {threads});
+      const ms::StepperChoice choice{threads, timing.single_precision};
+      const auto stepper = ms::make_stepper(model, kind, start, choice);
       t.stepper = stepper->name();
+      t.precision = stepper->precision();
       if (measure_settling) settle(t, *stepper, variant, start.x, equilibrium);
       // Timed from msfem bench's start (every node moved a pseudo-random thousandth of the mean
       // spring length), not from the settled state: a model at rest needs fewer CG iterations a
       // step than a moving one, and the two commands would time different work.
-      const auto timed = ms::make_stepper(model, kind, ms::perturbed_start(model), {threads});
+      const auto timed = ms::make_stepper(model, kind, ms::perturbed_start(model), choice);
       t.steps_per_second = median_rate(*timed, t.dt_s, timing.steps);
       break;
     } catch (const ms::DivergenceError&) {

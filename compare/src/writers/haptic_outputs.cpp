@@ -51,6 +51,7 @@ json variant_json(const VariantAlongPath& v) {
           {"realtime_priority", r.realtime_priority},
           {"integrator", r.integrator},
           {"stepper", r.stepper},
+          {"precision", r.precision},
           {"model_threads", r.model_threads},
           {"model_dt_s", r.model_dt_s},
           {"model_dt_halvings", r.halvings},

@@ -199,22 +199,24 @@ std::string tool_positions_table(const CaseRun& run) {
   return md.str();
 }
 
-// "the fast explicit kernels (a, b), the generic integrator (c)": the code each variant was timed
-// on (a model with a force field runs on the generic integrator).
+// "`fast_explicit` (a, b); `fast_implicit` in float (c)": the code each variant was timed on, and
+// its arithmetic where not double.
 std::string steppers_timed(const CaseRun& run) {
   std::vector<std::pair<std::string, std::string>> groups;  // stepper, variants
   for (const auto& v : run.variants) {
     if (v.timing.stepper.empty()) continue;
-    auto group = std::find_if(groups.begin(), groups.end(),
-                              [&](const auto& g) { return g.first == v.timing.stepper; });
+    const std::string code =
+        "`" + v.timing.stepper + "`" + (v.timing.precision == "float" ? " in float" : "");
+    auto group =
+        std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == code; });
     if (group == groups.end())
-      groups.emplace_back(v.timing.stepper, v.name);
+      groups.emplace_back(code, v.name);
     else
       group->second += ", " + v.name;
   }
   std::string text;
   for (const auto& [stepper, names] : groups)
-    text += (text.empty() ? "" : "; ") + std::string("`") + stepper + "` (" + names + ")";
+    text += (text.empty() ? "" : "; ") + stepper + " (" + names + ")";
   return text.empty() ? "no stepper (not timed)" : text;
 }
 

@@ -261,6 +261,7 @@ nlohmann::json variant_json(const CaseRun& run, const VariantResult& v) {
       {"not_resolved_by_reference", metric_names(unresolved_metrics(run, first, 0))},
       {"integrator", v.timing.integrator},
       {"stepper", v.timing.stepper},
+      {"precision", v.timing.precision},
       {"dt_s", v.timing.dt_s},
       {"steps_per_second", v.timing.steps_per_second},
       {"stable_dt_s", v.timing.stable_dt_s},

@@ -21,6 +21,7 @@ nlohmann::json point_json(const SweepPoint& p) {
           {"contact_refinement_edge_m", json_or_null(p.contact_edge_m)},
           {"integrator", p.integrator},
           {"stepper", p.stepper},
+          {"precision", p.precision},
           {"resolution", p.resolution},
           {"surface_vertices", p.surface_vertices},
           {"nodes", p.nodes},
@@ -85,7 +86,8 @@ std::string sweep_table(const std::vector<SweepPoint>& points) {
     std::snprintf(row, sizeof row,
                   "| %s | %s (%s) | %d | %d | %d | %d | %.4f%s | %.4f%s | %s / %s | %.3g | %.0f | "
                   "%.3g | %.3f |\n",
-                  p.model().c_str(), p.integrator.c_str(), p.stepper.c_str(), p.resolution,
+                  p.model().c_str(), p.integrator.c_str(),
+                  (p.stepper + (p.precision == "float" ? ", float" : "")).c_str(), p.resolution,
                   p.surface_vertices, p.nodes, p.springs, p.rel_l2_error,
                   flag(p, Metric::rel_l2_error), p.reaction_force_rel_error,
                   flag(p, Metric::reaction_force_rel_error),

@@ -334,7 +334,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
 }  // namespace
 
 FastImplicitStepper::FastImplicitStepper(const MechanicalSystem& model,
-                                         const FastImplicitOptions& options) {
+                                         const FastImplicitOptions& options)
+    : single_(options.single_precision) {
   if (options.threads > 64) throw ModelError("fast implicit stepper: at most 64 threads");
   impl_ = detail::kernel_for_lanes<GatherImplicitStepper, Implementation>(model, options, true);
 }

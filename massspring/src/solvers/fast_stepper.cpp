@@ -342,7 +342,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
 
 FastExplicitStepper::FastExplicitStepper(const MechanicalSystem& model,
                                          const FastStepperOptions& options)
-    : kind_(options.integrator) {
+    : kind_(options.integrator), single_(options.single_precision) {
   if (options.integrator != IntegratorKind::symplectic_euler &&
       options.integrator != IntegratorKind::explicit_euler &&
       options.integrator != IntegratorKind::rk4)

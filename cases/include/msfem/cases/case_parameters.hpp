@@ -159,8 +159,9 @@ struct FemParameters {
 
 struct TimingParameters {
   massspring::IntegratorKind integrator = massspring::IntegratorKind::symplectic_euler;
-  double dt_s = 0.0;  ///< 0: half the estimated stable step
-  int steps = 2000;   ///< dynamic steps timed for steps/s
+  double dt_s = 0.0;              ///< 0: half the estimated stable step
+  int steps = 2000;               ///< dynamic steps timed for steps/s
+  bool single_precision = false;  ///< timing/precision = float: the fast steppers in float
 };
 
 /// A tool load of a calibration: the case's tool pressed `depth_m` deep where `direction` points

@@ -67,6 +67,7 @@ class FastImplicitStepper : public Stepper {
   void step(double dt, int count = 1) override;
   IntegratorKind kind() const override { return IntegratorKind::implicit_euler; }
   const char* name() const override { return "fast_implicit"; }
+  const char* precision() const override { return single_ ? "float" : "double"; }
   int last_cg_iterations() const;
   /// Threads the last step ran on (1 while adaptive_threads found one faster).
   int last_step_threads() const;
@@ -80,6 +81,7 @@ class FastImplicitStepper : public Stepper {
 
  private:
   std::unique_ptr<Implementation> impl_;
+  bool single_;
 };
 
 }  // namespace msfem::massspring

@@ -72,6 +72,7 @@ class FastExplicitStepper : public Stepper {
 
   IntegratorKind kind() const override { return kind_; }
   const char* name() const override { return "fast_explicit"; }
+  const char* precision() const override { return single_ ? "float" : "double"; }
   bool batches_steps() const override { return true; }
 
   int num_nodes() const;
@@ -91,6 +92,7 @@ class FastExplicitStepper : public Stepper {
  private:
   std::unique_ptr<Implementation> impl_;
   IntegratorKind kind_;
+  bool single_;
 };
 
 }  // namespace msfem::massspring

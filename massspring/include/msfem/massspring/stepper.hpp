@@ -19,6 +19,8 @@ class Stepper {
   virtual IntegratorKind kind() const = 0;
   /// What runs the steps: "fast_explicit", "fast_implicit" or "generic".
   virtual const char* name() const = 0;
+  /// The arithmetic of the steps: "double" or "float" (the fast steppers' single precision).
+  virtual const char* precision() const { return "double"; }
   virtual void set_state(const State& state) = 0;
   virtual State state() const = 0;
   /// Advances `count` steps of size dt. Throws ModelError for a bad dt.
@@ -34,14 +36,16 @@ class Stepper {
 /// How make_stepper sets up what it picks; the fast implicit stepper keeps its haptic CG settings
 /// (FastImplicitOptions), the generic implicit Euler ImplicitOptions'.
 struct StepperChoice {
-  int threads = 0;  ///< > 0 caps the fast steppers' default thread count
+  int threads = 0;                ///< > 0 caps the fast steppers' default thread count
+  bool single_precision = false;  ///< the fast steppers in float (none other has it)
 };
 
 /// The stepper a simulator runs for `kind` on `system`, started at `start`: FastExplicitStepper
 /// for symplectic Euler, central difference (as symplectic Euler with velocities read at half
 /// steps: one force pass a step, the same stable step), explicit Euler and RK4;
 /// FastImplicitStepper for implicit Euler; the generic Integrator where the system has no springs
-/// for the kernels (no SpringForceField).
+/// for the kernels (no SpringForceField). Throws ModelError where single precision is asked of
+/// the generic integrator.
 std::unique_ptr<Stepper> make_stepper(const MechanicalSystem& system, IntegratorKind kind,
                                       const State& start, const StepperChoice& choice = {});
 

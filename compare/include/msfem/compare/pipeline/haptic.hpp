@@ -110,6 +110,7 @@ struct HapticReplay {
   TickStatistics tick;
   bool realtime_priority = false;  ///< the haptic thread ran under SCHED_FIFO
   std::string integrator, stepper;
+  std::string precision;  ///< the model's arithmetic: double or float (timing/precision)
   double model_dt_s = 0.0;
   double model_rate_hz = 0.0;  ///< model steps per wall second
   /// Model steps per second of its thread's stepping time: the rate it could run at (above

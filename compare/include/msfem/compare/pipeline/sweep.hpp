@@ -31,6 +31,7 @@ struct SweepSettings {
 struct SweepPoint {
   std::string variant, integrator;
   std::string stepper;               ///< the code timed (Timing::stepper)
+  std::string precision;             ///< its arithmetic (Timing::precision)
   bool volume_preservation = false;  ///< the variant's volume elements on
   /// With contact refinement on: the longest surface edge (m) within its radius of the tool.
   std::optional<double> contact_edge_m;

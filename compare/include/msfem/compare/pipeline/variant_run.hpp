@@ -114,6 +114,7 @@ struct Timing {
   /// The code timed: fast_explicit (FastExplicitStepper: explicit and symplectic Euler, central
   /// difference, RK4) or fast_implicit (FastImplicitStepper: implicit Euler).
   std::string stepper;
+  std::string precision;          ///< its arithmetic: double, or float (timing/precision)
   double dt_s = 0.0;              ///< step used for steps/s and settling
   double steps_per_second = 0.0;  ///< median over batches after warm-up
   double stable_dt_s = 0.0;       ///< largest bounded dt, by bisection
