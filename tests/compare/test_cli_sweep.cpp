@@ -78,6 +78,39 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
 }
 
+// The fast steppers' arithmetic as a sweep dimension: each variant and integrator timed in double
+// and in float on the same statics (the same error), each point saying which it timed.
+TEST(CliSweep, PrecisionIsSweptOnTheSameStatics) {
+  TemporaryDirectory tmp;
+  const auto out = tmp / "sweep";
+  const auto r = run_msfem("sweep " + small_sphere_case +
+                           " --quiet --resolutions 1 --integrators symplectic_euler,implicit_euler "
+                           "--set \"mass spring/variants=three_tier,single_layer\" "
+                           "--precision both --out " +
+                           out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
+  ASSERT_EQ(j["points"].size(), 8u);  // two variants, two integrators, two precisions
+  std::map<std::string, std::map<std::string, nlohmann::json>> by;  // variant+integrator, precision
+  for (const auto& p : j["points"]) {
+    EXPECT_GT(p["steps_per_second"].get<double>(), 0.0) << p.dump();
+    by[p["variant"].get<std::string>() + " " + p["integrator"].get<std::string>()]
+      [p["precision"].get<std::string>()] = p;
+  }
+  ASSERT_EQ(by.size(), 4u);
+  for (const auto& [model, points] : by) {
+    ASSERT_EQ(points.size(), 2u) << model;
+    EXPECT_EQ(points.at("float")["rel_l2_error"], points.at("double")["rel_l2_error"]) << model;
+    EXPECT_EQ(points.at("float")["stepper"], points.at("double")["stepper"]) << model;
+  }
+  EXPECT_NE(read_text(out / "report.md").find("(fast_implicit, float)"), std::string::npos);
+  const auto bad = run_msfem("sweep " + small_sphere_case + " --quiet --precision half --out " +
+                             (tmp / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--precision"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+}
+
 // Contact refinement as a sweep dimension: off, and on at two edge lengths, each pass with its own
 // refined surface and FEM; the finer the edge, the more nodes, and each point says its edge.
 TEST(CliSweep, ContactRefinementIsSweptAtEachEdgeLength) {

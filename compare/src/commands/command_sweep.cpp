@@ -62,6 +62,13 @@ std::vector<bool> volume_settings(const std::string& value) {
   return value == "both" ? std::vector<bool>{false, true} : std::vector<bool>{value == "on"};
 }
 
+// --precision double|float|both: the fast steppers' arithmetic, each timed.
+std::vector<bool> precision_settings(const std::string& value) {
+  if (value != "double" && value != "float" && value != "both")
+    throw cases::InputError("option --precision: '" + value + "' is not double, float or both");
+  return value == "both" ? std::vector<bool>{false, true} : std::vector<bool>{value == "float"};
+}
+
 // --contact-refinement off|on|both with --contact-edge-lengths E1,E2 (m; each a pass, on implied):
 // none for the off pass, each edge length (0: the case's) for an on pass.
 std::vector<std::optional<double>> refinement_settings(const std::optional<std::string>& mode,
@@ -89,12 +96,12 @@ std::vector<std::optional<double>> refinement_settings(const std::optional<std::
 int sweep_command(const Arguments& args) {
   const Options opt(args, {"quiet", "json"},
                     {"out", "set", "resolutions", "integrators", "max-error", "volume-preservation",
-                     "contact-refinement", "contact-edge-lengths"});
+                     "contact-refinement", "contact-edge-lengths", "precision"});
   if (opt.positional().size() != 1)
     throw std::invalid_argument(
         "usage: msfem sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--max-error E] "
         "[--volume-preservation off|on|both] [--contact-refinement off|on|both] "
-        "[--contact-edge-lengths E1,E2] [--out DIR]");
+        "[--contact-edge-lengths E1,E2] [--precision double|float|both] [--out DIR]");
   std::optional<double> max_error;
   if (const auto e = opt.value("max-error")) max_error = positive_number("max-error", *e);
   const cases::CaseParameters parameters = cases::read_case(opt.positional()[0], opt.values("set"));
@@ -103,6 +110,7 @@ int sweep_command(const Arguments& args) {
   if (const auto r = opt.value("resolutions")) settings.resolutions = integers("resolutions", *r);
   if (const auto v = opt.value("volume-preservation"))
     settings.volume_preservation = volume_settings(*v);
+  if (const auto v = opt.value("precision")) settings.single_precision = precision_settings(*v);
   settings.contact_refinement =
       refinement_settings(opt.value("contact-refinement"), opt.value("contact-edge-lengths"));
   if (!settings.contact_refinement.empty() && !parameters.loads.tool.enabled)

@@ -33,8 +33,9 @@ const std::vector<CommandEntry>& commands() {
        "sweep CASE.prm [--resolutions 2,3,4] [--integrators a,b] [--out DIR] [--set K=V]...\n"
        "          [--max-error E] [--volume-preservation off|on|both] [--quiet] [--json]\n"
        "          [--contact-refinement off|on|both] [--contact-edge-lengths E1,E2]\n"
+       "          [--precision double|float|both]\n"
        "      variants x resolutions x integrators (x volume preservation x contact refinement\n"
-       "      and its edge lengths, m): sweep.json, report.md\n"
+       "      and its edge lengths, m, x the fast steppers' arithmetic): sweep.json, report.md\n"
        "      opening with the least-error configuration for a 60 Hz and a 1 kHz loop in real\n"
        "      time (and the cheapest within rel L2 E), table and Pareto plot"},
       {"regress", regress_command,

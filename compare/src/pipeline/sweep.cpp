@@ -57,12 +57,14 @@ cases::CaseParameters at_resolution(cases::CaseParameters p, int resolution) {
 
 // Variant `v` of the run with one integrator, timed at half that integrator's stable step.
 SweepPoint timed_point(const CaseRun& run, const VariantResult& v, const BuiltVariant& built,
-                       massspring::IntegratorKind integrator, int resolution) {
+                       massspring::IntegratorKind integrator, bool single_precision,
+                       int resolution) {
   const LoadReference& load = run.loads.front();
   const ToolLoadVariant& at_load = v.loads.front();
   cases::TimingParameters timing = run.problem.parameters.timing;
   timing.integrator = integrator;
   timing.dt_s = 0.0;  // each integrator at half its own stable step
+  timing.single_precision = single_precision;
   // From run_case's equilibrium, reached from rest as here.
   // Under mpirun the ranks on a machine time one item each at the same time: each takes its share
   // of the cores, so that no timed thread waits on a barrier for a thread that has no core.
@@ -127,16 +129,21 @@ void share_points(std::vector<SweepPoint>& points, const std::vector<bool>& mine
 // Which rank times each (variant, integrator) item. A timing costs about the model's nodes times
 // its integrator's price per step (on the fast kernels, in contact, implicit Euler's warm-started
 // CG step some 3-9 symplectic steps on the sphere, RK4's four force passes 4-9).
-std::vector<int> owners(
-    const CaseRun& run,
-    const std::vector<std::pair<std::size_t, massspring::IntegratorKind>>& items) {
+// One timing of a sweep: a variant of the run, an integrator and the arithmetic.
+struct SweepItem {
+  std::size_t variant;
+  massspring::IntegratorKind integrator;
+  bool single_precision;
+};
+
+std::vector<int> owners(const CaseRun& run, const std::vector<SweepItem>& items) {
   std::vector<double> cost(items.size());
   for (std::size_t j = 0; j < items.size(); ++j) {
-    const massspring::IntegratorKind k = items[j].second;
+    const massspring::IntegratorKind k = items[j].integrator;
     const double price = k == massspring::IntegratorKind::implicit_euler ? 6.0
                          : k == massspring::IntegratorKind::rk4          ? 6.0
                                                                          : 1.0;
-    cost[j] = price * run.variants[items[j].first].nodes;
+    cost[j] = price * run.variants[items[j].variant].nodes;
   }
   return ranks::deal(cost);
 }
@@ -199,11 +206,15 @@ std::vector<SweepPoint> sweep_resolution(cases::CaseParameters p, int resolution
   if (run.problem.local_refinement) edge = run.problem.local_refinement->edge_m;
   for (const auto& [name, why] : run.failed_variants)
     failed.push_back({resolution, SweepPoint::model_name(name, volume, edge), why});
-  std::vector<std::pair<std::size_t, massspring::IntegratorKind>> items;
+  const std::vector<bool> precisions = settings.single_precision.empty()
+                                           ? std::vector<bool>{p.timing.single_precision}
+                                           : settings.single_precision;
+  std::vector<SweepItem> items;
   for (std::size_t v = 0; v < run.variants.size(); ++v)
     if (!volume || run.variants[v].parameters.volume_preservation)
       for (const auto& integrator : settings.integrators)
-        items.emplace_back(v, integrator);
+        for (const bool single : precisions)
+          items.push_back({v, integrator, single});
   std::vector<SweepPoint> points(items.size());
   std::vector<bool> mine(items.size());
   const std::vector<int> owner = owners(run, items);
@@ -213,11 +224,12 @@ std::vector<SweepPoint> sweep_resolution(cases::CaseParameters p, int resolution
     std::optional<std::pair<std::size_t, BuiltVariant>> built;  // the last variant built here
     for (std::size_t j = 0; j < items.size(); ++j) {
       if (!mine[j]) continue;
-      const VariantResult& v = run.variants[items[j].first];
-      if (!built || built->first != items[j].first)
-        built.emplace(items[j].first,
+      const VariantResult& v = run.variants[items[j].variant];
+      if (!built || built->first != items[j].variant)
+        built.emplace(items[j].variant,
                       build_variant(v.spec, run.problem, run.mesh, run.loads.front().tool));
-      points[j] = timed_point(run, v, built->second, items[j].second, resolution);
+      points[j] = timed_point(run, v, built->second, items[j].integrator, items[j].single_precision,
+                              resolution);
     }
   });
   if (ranks::count() > 1) share_points(points, mine);

@@ -25,6 +25,9 @@ struct SweepSettings {
   /// Contact refinement (a local point distribution at the tool) per pass: none for off, else on
   /// with that edge length (m; 0: the case's). Empty: as the case sets it.
   std::vector<std::optional<double>> contact_refinement;
+  /// The fast steppers timed in double (false) and/or float (true); empty: as the case sets it
+  /// (timing/precision).
+  std::vector<bool> single_precision;
   bool quiet = false;
 };
 
