@@ -184,11 +184,10 @@ double farthest(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return largest;
 }
 
-// Steps the two steppers side by side from the loaded start, `every` steps between checkpoints.
-template <class Stepper>
+// Steps the two steppers side by side from the loaded start, `every` steps of dt between
+// checkpoints.
 PrecisionComparison compare_side_by_side(const MassSpringModel& model, Stepper& exact,
-                                         Stepper& single, int steps, int every,
-                                         const std::function<void(Stepper&, int)>& advance) {
+                                         Stepper& single, double dt, int steps, int every) {
   const State start = loaded_start(model);
   const Eigen::VectorXd rest = initial_state(model).x;
   exact.set_state(start);
@@ -197,8 +196,8 @@ PrecisionComparison compare_side_by_side(const MassSpringModel& model, Stepper& 
   c.max_displacement_m = farthest(start.x, rest);
   for (c.steps = 0; c.steps < steps;) {
     const int n = std::min(every, steps - c.steps);
-    advance(exact, n);
-    advance(single, n);
+    exact.step(dt, n);
+    single.step(dt, n);
     c.steps += n;
     const Eigen::VectorXd x = exact.state().x;
     c.max_node_error_m = std::max(c.max_node_error_m, farthest(x, single.state().x));
@@ -216,8 +215,7 @@ PrecisionComparison compare_precision(const MassSpringModel& model, double dt, i
   FastExplicitStepper exact(model, options);
   options.single_precision = true;
   FastExplicitStepper single(model, options);
-  return compare_side_by_side<FastExplicitStepper>(
-      model, exact, single, steps, 100, [dt](FastExplicitStepper& s, int n) { s.step(dt, n); });
+  return compare_side_by_side(model, exact, single, dt, steps, 100);
 }
 
 PrecisionComparison compare_implicit_precision(const MassSpringModel& model,
@@ -227,11 +225,7 @@ PrecisionComparison compare_implicit_precision(const MassSpringModel& model,
   in_double.single_precision = false;
   in_float.single_precision = true;
   FastImplicitStepper exact(model, in_double), single(model, in_float);
-  return compare_side_by_side<FastImplicitStepper>(model, exact, single, steps, 10,
-                                                   [dt](FastImplicitStepper& s, int n) {
-                                                     for (int k = 0; k < n; ++k)
-                                                       s.step(dt);
-                                                   });
+  return compare_side_by_side(model, exact, single, dt, steps, 10);
 }
 
 namespace {
