@@ -201,7 +201,8 @@ int bench_massspring(const Options& options) {
     if (!json)
       std::printf(
           "%-18s %8d nodes %9d springs  explicit %9.0f steps/s (%.0f-%.0f)  naive %8.0f steps/s "
-          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.)  float/double %.1e  explicit %.2f GB/s "
+          "(x%.1f)  implicit %8.0f steps/s (%.1f CG it.; float %.0f)  float/double %.1e  explicit "
+          "%.2f GB/s "
           "(%.0f %% of stream, %.0f %% of the triad at its %.1f MB)\n",
           c.name.c_str(), result.nodes, result.springs, result.explicit_steps_per_second,
           result.explicit_spread.min, result.explicit_spread.max, result.naive_steps_per_second,
@@ -209,6 +210,7 @@ int bench_massspring(const Options& options) {
               ? result.explicit_steps_per_second / result.naive_steps_per_second
               : 0.0,
           result.implicit_steps_per_second, result.implicit_mean_cg_iterations,
+          result.implicit_float_steps_per_second,
           result.float_vs_double ? result.float_vs_double->relative() : 0.0,
           1e-9 * result.explicit_bytes_per_step * result.explicit_steps_per_second,
           stream > 0
