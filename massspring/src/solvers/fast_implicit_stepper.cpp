@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "implicit_fields.hpp"
@@ -103,7 +104,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   int num_springs() const override { return soa_.num_springs; }
 
   // Solves (M - h D - h² K) Δv = h (f + h K v) by CG from the last step's Δv, to
-  // ‖r‖ <= cg_tolerance ‖b‖ or cg_max_iterations, then v += Δv, x += h v.
+  // ‖r‖ <= cg_tolerance ‖b‖ (or b's rounding noise, spring_rounding) or cg_max_iterations, then
+  // v += Δv, x += h v.
   void step(double dt) override {
     check_time_step(dt);
     const Real h = static_cast<Real>(dt);
@@ -156,7 +158,10 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
             sums);
       }
       double gamma = sums[0], rr = sums[1], alpha = 0.0, previous_gamma = 0.0;
-      const double target = options_.cg_tolerance * options_.cg_tolerance * sums[2];
+      // ‖r‖ ≤ cg_tolerance ‖b‖, or the rounding noise of b where that is larger: near rest b is
+      // at its springs' rounding, and a CG that chased it would only fit noise.
+      const double target =
+          std::max(options_.cg_tolerance * options_.cg_tolerance * sums[2], dt * dt * rounding_);
       int iteration = 0;
       while (iteration < options_.cg_max_iterations && rr > target) {
         double delta[3];  // u·A u
@@ -250,6 +255,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   // The fields and the right-hand side vector they add to (kept by the linearising pass only
   // then: it costs a model without fields a store per lane).
   void take_fields(const MechanicalSystem& model) {
+    rounding_ = spring_rounding();
     fields_.take(model);
     share_blocks();
     fields_.plan(member_block_);
@@ -262,6 +268,23 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       block_[e].assign(fields_.empty() ? 0 : lanes, Real(0));
       cg_.block[e] = fields_.empty() ? nullptr : block_[e].data();
     }
+  }
+
+  // ‖noise‖² / h² of the springs' part of b: a spring's force k (1 - l0 / l) d carries about the
+  // unit round-off u of k l0 (1 - l0 / l is a difference of numbers near 1), independently at
+  // each end and spring: u² Σ (k l0)² over the spring ends at free nodes. On the brain's three
+  // tiers in float, u h √(that) = 3.5e-10 N·s, and ‖b‖ at rest after a ring-down measured
+  // 3.6e-10.
+  double spring_rounding() const {
+    const double unit = 0.5 * static_cast<double>(std::numeric_limits<Real>::epsilon());
+    double sum = 0.0;
+    for (int s = 0; s < soa_.num_springs; ++s) {
+      const double force = static_cast<double>(soa_.stiffness_rest[static_cast<std::size_t>(s)]);
+      const int free_ends = (soa_.a[static_cast<std::size_t>(s)] < soa_.num_free) +
+                            (soa_.b[static_cast<std::size_t>(s)] < soa_.num_free);
+      sum += free_ends * force * force;
+    }
+    return unit * unit * sum;
   }
 
   // r·u, r·r and b·b over the lanes of block `block`, once the fields have changed r and u.
@@ -329,6 +352,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   std::vector<double> block_sums_[2];  // per block of chunks: three partial sums
   double time_ = 0.0;
   int last_iterations_ = 0;
+  double rounding_ = 0.0;  // spring_rounding()
 };
 
 }  // namespace
