@@ -18,7 +18,9 @@ struct FastImplicitOptions {
   /// Relative CG residual, ‖b - A Δv‖ <= cg_tolerance ‖b‖. The haptic default 1e-2, with the
   /// warm start from the last step's Δv, keeps positions within ~1e-3 (relative to the
   /// displacement) of a tight solve over 100 steps at dt = 1 ms on the brain and on a small sphere
-  /// (a test checks the sphere); use 1e-8 or below for a reference-quality step.
+  /// (a test checks the sphere); use 1e-8 or below for a reference-quality step. Near rest, where
+  /// b is down to the rounding of its spring forces (u k l0 a spring end, u the precision's unit
+  /// round-off), the CG stops at that instead: a smaller residual would fit the rounding.
   double cg_tolerance = 1e-2;
   /// Cap on CG iterations per step: bounds a haptic step's time. A step that reaches it is not
   /// solved to cg_tolerance; last_cg_iterations() tells.
