@@ -14,6 +14,15 @@ using testing::run_msfem;
 using testing::small_sphere_case;
 using testing::TemporaryDirectory;
 
+// sweep.json of `msfem sweep` on the small sphere at icosphere level 1 with `options`, written
+// under `out`; fails the test where the sweep does not exit 0.
+nlohmann::json level_one_sweep(const std::filesystem::path& out, const std::string& options) {
+  const auto r = run_msfem("sweep " + small_sphere_case + " --quiet --resolutions 1 " + options +
+                           " --out " + out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? nlohmann::json::parse(read_text(out / "sweep.json")) : nlohmann::json();
+}
+
 TEST(CliSweep, AResolutionThatCannotBeRunIsReportedAndTheOthersAreStillSwept) {
   // Icosphere level 10 is out of range: as a surface that self-intersects once simplified (the
   // brain below ~2,500 vertices) it is bad input at that resolution only.
@@ -48,13 +57,10 @@ TEST(CliSweep, AResolutionThatCannotBeRunIsReportedAndTheOthersAreStillSwept) {
 TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
-  const auto r =
-      run_msfem("sweep " + small_sphere_case +
-                " --quiet --resolutions 1 --integrators symplectic_euler "
-                "--volume-preservation both --set \"material/poisson ratio=0.45\" --out " +
-                out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
+  const auto j = level_one_sweep(out,
+                                 "--integrators symplectic_euler --volume-preservation both "
+                                 "--set \"material/poisson ratio=0.45\"");
+  ASSERT_FALSE(j.is_null());
   std::map<std::string, std::vector<double>> errors;  // variant -> rel L2 without, with
   for (const auto& p : j["points"]) {
     EXPECT_EQ(p["stepper"], "fast_explicit");
@@ -83,13 +89,10 @@ TEST(CliSweep, VolumePreservationIsSweptForTheVariantsThatHaveIt) {
 TEST(CliSweep, PrecisionIsSweptOnTheSameStatics) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
-  const auto r = run_msfem("sweep " + small_sphere_case +
-                           " --quiet --resolutions 1 --integrators symplectic_euler,implicit_euler "
-                           "--set \"mass spring/variants=three_tier,single_layer\" "
-                           "--precision both --out " +
-                           out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
+  const auto j = level_one_sweep(out,
+                                 "--integrators symplectic_euler,implicit_euler --set \"mass "
+                                 "spring/variants=three_tier,single_layer\" --precision both");
+  ASSERT_FALSE(j.is_null());
   ASSERT_EQ(j["points"].size(), 8u);  // two variants, two integrators, two precisions
   std::map<std::string, std::map<std::string, nlohmann::json>> by;  // variant+integrator, precision
   for (const auto& p : j["points"]) {
@@ -116,13 +119,11 @@ TEST(CliSweep, PrecisionIsSweptOnTheSameStatics) {
 TEST(CliSweep, ContactRefinementIsSweptAtEachEdgeLength) {
   TemporaryDirectory tmp;
   const auto out = tmp / "sweep";
-  const auto r = run_msfem("sweep " + small_sphere_case +
-                           " --quiet --resolutions 1 --integrators symplectic_euler "
-                           "--set \"mass spring/variants=single_layer\" --contact-refinement both "
-                           "--contact-edge-lengths 0.006,0.003 --out " +
-                           out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto j = nlohmann::json::parse(read_text(out / "sweep.json"));
+  const auto j =
+      level_one_sweep(out,
+                      "--integrators symplectic_euler --set \"mass spring/variants=single_layer\" "
+                      "--contact-refinement both --contact-edge-lengths 0.006,0.003");
+  ASSERT_FALSE(j.is_null());
   ASSERT_EQ(j["points"].size(), 3u);
   const auto& points = j["points"];
   EXPECT_TRUE(points[0]["contact_refinement_edge_m"].is_null());

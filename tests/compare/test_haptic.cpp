@@ -41,6 +41,23 @@ std::filesystem::path write(const std::filesystem::path& file, const std::string
   return file;
 }
 
+// A device path for the small case's tool: from 6 mm above the surface, pressed `depth` deep along
+// the tool's normal at 0.3 s, then held; written to `dir`/press.csv. Returns the file and the
+// tool's outward normal.
+std::pair<std::filesystem::path, Eigen::Vector3d> press_and_hold(const std::filesystem::path& dir,
+                                                                 double depth) {
+  const compare::Problem problem = compare::make_problem(cases::read_case(case_file, small));
+  const compare::ToolPlacement& tool = problem.tools.front();
+  const Eigen::Vector3d n = tool.outward_normal, above = tool.contact_point + 0.006 * n;
+  const Eigen::Vector3d pressed = tool.contact_point + (tool.radius - depth) * n;
+  std::ostringstream csv;
+  csv.precision(17);
+  csv << "t_s,x_m,y_m,z_m\n0," << above.x() << ',' << above.y() << ',' << above.z() << '\n';
+  for (double t : {0.3, 3.0})
+    csv << t << ',' << pressed.x() << ',' << pressed.y() << ',' << pressed.z() << '\n';
+  return {write(dir / "press.csv", csv.str()), n};
+}
+
 TEST(ToolPath, IsLinearBetweenSamplesAndHeldOutside) {
   const compare::ToolPath path({1.0, 2.0, 4.0}, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
                                                  Eigen::Vector3d(1, 2, 0)});
@@ -176,17 +193,10 @@ TEST(HapticChanges, ParsesSortsAndRefusesWhatCannotChangeWhileRunning) {
 // springs are made three times stiffer, as from the seed's menu (the force rises about 11 %).
 TEST(HapticReplay, RendersTheModelsForceAndShowsAChangeAtItsTime) {
   TemporaryDirectory dir;
-  const compare::Problem problem = compare::make_problem(cases::read_case(case_file, small));
-  const compare::ToolPlacement& tool = problem.tools.front();
   const double depth = 0.004;
-  const Eigen::Vector3d n = tool.outward_normal, above = tool.contact_point + 0.006 * n;
-  const Eigen::Vector3d pressed = tool.contact_point + (tool.radius - depth) * n;
-  std::ostringstream csv;
-  csv.precision(17);
-  csv << "t_s,x_m,y_m,z_m\n0," << above.x() << ',' << above.y() << ',' << above.z() << '\n';
-  for (double t : {0.3, 3.0})
-    csv << t << ',' << pressed.x() << ',' << pressed.y() << ',' << pressed.z() << '\n';
-  const auto path = write(dir / "press.csv", csv.str());
+  const auto press = press_and_hold(dir.path(), depth);
+  const std::filesystem::path& path = press.first;
+  const Eigen::Vector3d n = press.second;
   const auto out = dir / "haptic";
   const auto r = run_msfem("haptic " + case_file + small_options() + " --path " + path.string() +
                            " --seconds 2.5 --set-at '1.5:mass spring/group scales=tier1_edges:3'" +
@@ -270,16 +280,7 @@ TEST(HapticReplay, RendersTheModelsForceAndShowsAChangeAtItsTime) {
 // as the double model's is in RendersTheModelsForceAndShowsAChangeAtItsTime.
 TEST(HapticReplay, AFloatModelRendersTheHeldForce) {
   TemporaryDirectory dir;
-  const compare::Problem problem = compare::make_problem(cases::read_case(case_file, small));
-  const compare::ToolPlacement& tool = problem.tools.front();
-  const Eigen::Vector3d n = tool.outward_normal, above = tool.contact_point + 0.006 * n;
-  const Eigen::Vector3d pressed = tool.contact_point + (tool.radius - 0.004) * n;
-  std::ostringstream csv;
-  csv.precision(17);
-  csv << "t_s,x_m,y_m,z_m\n0," << above.x() << ',' << above.y() << ',' << above.z() << '\n';
-  for (double t : {0.3, 3.0})
-    csv << t << ',' << pressed.x() << ',' << pressed.y() << ',' << pressed.z() << '\n';
-  const auto path = write(dir / "press.csv", csv.str());
+  const auto path = press_and_hold(dir.path(), 0.004).first;
   const auto out = dir / "haptic";
   const auto r =
       run_msfem("haptic " + case_file + small_options() + " --set timing/precision=float --path " +
