@@ -323,8 +323,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   }
 
   // Float records hold displacements from a rest frame, as the explicit stepper's do
-  // (soa_layout.hpp): from float positions a millimetre spring's force carries 4e-6 of its
-  // length in noise each step, which the warm-started CG then chases.
+  // (soa_layout.hpp): float positions 1.5 m from the origin are good to 1e-7 m, a millimetre
+  // spring's length to a ten-thousandth of itself.
   static constexpr bool kRelative = std::is_same_v<Real, float>;
 
   const MechanicalSystem* model_;
