@@ -126,6 +126,37 @@ TEST(FastExplicitStepper, AdaptiveThreadsProbeBothCountsAndChangeNoResult) {
   }
 }
 
+// Each member takes its own range of blocks first, then what is left of the others' (a counter
+// per range): with three and four members on a model of about 18 blocks the ranges are uneven
+// and members steal, across the four passes of an RK4 step and several steps a call. A block
+// taken by no one would leave its nodes a step behind, and every team size would part from one
+// thread.
+TEST(FastExplicitStepper, EveryTeamSizeTakesEveryBlockOnce) {
+  const MassSpringModel model = loaded_three_tier();
+  const double dt =
+      0.5 * predicted_stable_dt(model, IntegratorKind::central_difference, model.initial_state());
+  for (const IntegratorKind kind : {IntegratorKind::symplectic_euler, IntegratorKind::rk4}) {
+    FastStepperOptions one;
+    one.threads = 1;
+    one.integrator = kind;
+    FastExplicitStepper reference(model, one);
+    reference.step(dt, 150);
+    for (const int threads : {2, 3, 4}) {
+      FastStepperOptions team = one;
+      team.threads = threads;
+      team.adaptive_threads = false;
+      FastExplicitStepper stepper(model, team);
+      for (int call = 0; call < 50; ++call)
+        stepper.step(dt, 3);
+      EXPECT_EQ(stepper.last_step_threads(), threads);
+      EXPECT_EQ((stepper.state().x - reference.state().x).cwiseAbs().maxCoeff(), 0.0)
+          << to_string(kind) << ", " << threads << " threads";
+      EXPECT_EQ((stepper.state().v - reference.state().v).cwiseAbs().maxCoeff(), 0.0)
+          << to_string(kind) << ", " << threads << " threads";
+    }
+  }
+}
+
 // Damping that differs between springs takes the per-spring path of the kernels (a uniform
 // damping, as in loaded_three_tier, takes another).
 TEST(FastExplicitStepper, MatchesSymplecticEulerWithPerSpringDamping) {

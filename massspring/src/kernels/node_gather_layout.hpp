@@ -196,16 +196,20 @@ struct NodeGatherLayout {
       }
   }
 
-  // Blocks of consecutive chunks, about kBlockSlots slots each, handed out to the threads one at a
-  // time (see fast_stepper.cpp): small enough that a thread the OS pre-empts holds up the others
-  // for one block only, large enough that taking one costs nothing. The implicit stepper, which
-  // shares them out once, asks for smaller ones on a small model.
+  // Blocks of consecutive chunks, about kBlockSlots slots each, the units the steppers share out
+  // among their threads (see fast_stepper.cpp): small enough that a thread the OS pre-empts holds
+  // up the others for one block only, large enough that taking one costs nothing.
   void partition(int block_slots = kBlockSlots) {
     block_begin.assign(1, 0);
     for (int chunk = 0; chunk < num_chunks; ++chunk)
       if (chunk_slot[chunk + 1] - chunk_slot[block_begin.back()] >= block_slots)
         block_begin.push_back(chunk + 1);
     if (block_begin.back() != num_chunks) block_begin.push_back(num_chunks);
+  }
+  // Smaller blocks on a small model, about 32 a member: with kBlockSlots the seed sphere has five
+  // blocks, and two members' shares of a pass could differ by one, a fifth of the work.
+  void partition_for(int members) {
+    partition(std::clamp(chunk_slot.back() / (32 * members), 256, kBlockSlots));
   }
 };
 

@@ -50,7 +50,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         p_records_(detail::kDirection * (soa_.num_nodes + 2)),
         dv_records_(detail::kDirection * (soa_.num_nodes + 2)),
         fields_(soa_, gather_, team_.size()) {
-    gather_.partition(block_slots(gather_.chunk_slot.back(), team_.size()));
+    gather_.partition_for(team_.size());
     const std::size_t lanes = gather_.lane_node.size();
     system_.resize(gather_.chunk_slot.back(), lanes,
                    options.single_precision_terms && options.cg_tolerance >= kSingleTermsTolerance);
@@ -224,11 +224,6 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
  private:
   int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
 
-  // Blocks of about this many slots: on a small model the layout's blocks (kBlockSlots) are a
-  // member's share or more, and the members' shares of the work differed by a third.
-  static int block_slots(int slots, int members) {
-    return std::clamp(slots / (32 * members), 256, detail::kBlockSlots);
-  }
 
   // The members' first blocks, then the number of blocks: equal shares of the work, the springs'
   // slots and the fields' rows (ImplicitFields::block_work) in one count.
