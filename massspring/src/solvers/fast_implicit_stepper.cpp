@@ -224,7 +224,6 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
  private:
   int blocks() const { return static_cast<int>(gather_.block_begin.size()) - 1; }
 
-
   // The members' first blocks, then the number of blocks: equal shares of the work, the springs'
   // slots and the fields' rows (ImplicitFields::block_work) in one count.
   void share_blocks() {
