@@ -451,6 +451,26 @@ TEST(SteppingBenchmark, ReportsRatesForASmallModel) {
   EXPECT_LT(result.explicit_bytes_per_step, 3 * least);
 }
 
+// In float the bench's implicit figures are float's, and the comparison with double still runs:
+// the implicit_float fields never read as zero beside a float implicit figure.
+TEST(SteppingBenchmark, InFloatTheFloatImplicitFiguresAreTheImplicitOnes) {
+  const MassSpringModel model = loaded_three_tier();
+  SteppingBenchmarkOptions options;
+  options.seconds_per_sample = 0.01;
+  options.samples = 3;
+  options.single_precision = true;
+  options.run_naive = options.compare_precision = options.run_other_integrators = false;
+  const SteppingBenchmarkResult result = run_stepping_benchmark(model, options);
+  EXPECT_GT(result.implicit_steps_per_second, 0.0);
+  EXPECT_EQ(result.implicit_float_steps_per_second, result.implicit_steps_per_second);
+  EXPECT_EQ(result.implicit_float_spread.min, result.implicit_spread.min);
+  EXPECT_EQ(result.implicit_float_mean_cg_iterations, result.implicit_mean_cg_iterations);
+  ASSERT_TRUE(result.implicit_float_vs_double);
+  EXPECT_EQ(result.implicit_float_vs_double->steps, 100);
+  EXPECT_GT(result.implicit_float_vs_double->max_displacement_m, 0.0);
+  EXPECT_LT(result.implicit_float_vs_double->relative(), 1e-4);
+}
+
 TEST(SteppingBenchmark, TimesEachIntegratorAtTheStepACaseGives) {
   const MassSpringModel model = loaded_three_tier();
   SteppingBenchmarkOptions options;

@@ -107,7 +107,8 @@ struct SteppingBenchmarkResult {
   int explicit_last_step_threads = 0;  ///< where adaptive threads ended (1 or threads)  ///<
                                        ///< FastExplicitStepper::streamed_bytes_per_step
   std::optional<PrecisionComparison> float_vs_double;  ///< when options.compare_precision
-  /// The implicit stepper in float beside the double one (options.run_implicit_float).
+  /// The implicit stepper in float beside the double one (options.run_implicit_float); with
+  /// options.single_precision the implicit figures above, the comparison with double still run.
   double implicit_float_steps_per_second = 0.0;
   double implicit_float_mean_cg_iterations = 0.0;
   RateSpread implicit_float_spread;
