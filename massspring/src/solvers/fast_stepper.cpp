@@ -149,13 +149,13 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
   // first, then what is left of the others' ranges: a thread the OS pre-empts holds a pass up by a
   // block, not by its whole range. The blocks come from one ticket counter per range (on its own
   // cache line). In each pass every member draws from every range until it gets a ticket past
-  // the range's end, so a pass uses exactly size + members tickets of each counter and the next
-  // pass's start at a known number without a reset. Home ranges, not one counter for all blocks:
-  // a member then writes the same nodes' records every step, and the records the other member
-  // reads are those at the ranges' boundaries. With a single counter each step's blocks went to
-  // whichever member drew them, so a member read records the other had written the step before;
-  // when the host placed the two vCPUs on different core complexes (a cache line between them
-  // 335 ns instead of 100), two threads stepped the brain no faster than one.
+  // the range's end, so a pass uses exactly size + members tickets of each counter, and the next
+  // pass's tickets start at a known number without a reset. Home ranges, not one counter for all
+  // blocks: a member then writes the same nodes' records every step, and reads the other's only
+  // at the ranges' boundaries. With a single counter each step's blocks went to whichever member
+  // drew them, so a member read records the other had written the step before; when the host put
+  // the two vCPUs on different core complexes (a cache line between them 335 ns instead of 100),
+  // two threads stepped the brain no faster than one.
   template <class Take>
   void take_blocks(int member, int members, long blocks, long pass, const Take& take) {
     for (int k = 0; k < members; ++k) {
