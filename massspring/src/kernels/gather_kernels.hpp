@@ -171,39 +171,42 @@ inline bool cpu_has_avx512() {
 }
 #endif
 
-// Lanes per chunk for a precision and a model. Floats take 16 (AVX-512) only while the springs and
-// node records stay well inside one core complex's L3 (32 MB on the Zen machine; sysconf reports
-// the whole socket's, so a fixed bound): measured there, 16 lanes were ~15 % faster than 8 at brain
-// scale (5 MB) and ~15-20 % slower at 10x brain (47 MB), where the step streams from memory.
+// Lanes per chunk for a precision and a model, where the CPU has AVX-512 and `allow_avx512`:
+// doubles take 8 (one 512-bit vector; against 4 lanes of AVX2 with the same 1/√ estimate,
+// measured alternated in one process: the brain's implicit step +7 %, its explicit step +5 %,
+// the seed sphere's implicit step +19 % on one thread, 10x brain's explicit step -2 %).
+// Floats take 16 only while the springs and node records stay well inside one core complex's L3
+// (32 MB on the Zen machine; sysconf reports the whole socket's, so a fixed bound): measured there,
+// 16 lanes were ~15 % faster than 8 at brain scale (5 MB) and ~15-20 % slower at 10x brain
+// (47 MB), where the step streams from memory. Otherwise a 256-bit vector's (AVX2 or portable).
 template <class Real>
 int preferred_lanes(bool allow_avx512, long springs, long nodes) {
-  if (!std::is_same_v<Real, float>) return 4;
+  const bool avx512 = allow_avx512 && cpu_has_avx512();
+  if (!std::is_same_v<Real, float>) return avx512 ? 8 : 4;
   constexpr long kCacheBytes = 24L << 20;
   const long bytes = 2 * springs * 3 * static_cast<long>(sizeof(Real)) + 2 * nodes * 32;
-  return allow_avx512 && cpu_has_avx512() && bytes < kCacheBytes ? 16 : 8;
+  return avx512 && bytes < kCacheBytes ? 16 : 8;
 }
 
 #if MSFEM_HAVE_X86_DISPATCH
-#define MSFEM_DISPATCH(NAME, ...)                                     \
-  if constexpr (W == 16) {                                            \
-    return NAME##_avx512<Avx512Float>(__VA_ARGS__);                   \
-  } else if constexpr (W == 32 / sizeof(Real)) {                      \
-    if constexpr (std::is_same_v<Real, double>)                       \
-      if (avx512_) return NAME##_avx512<Avx512VlDouble>(__VA_ARGS__); \
-    if (avx2_) return NAME##_avx2<Avx2<Real>>(__VA_ARGS__);           \
-  }                                                                   \
+#define MSFEM_DISPATCH(NAME, ...)                           \
+  if constexpr (W * sizeof(Real) == 64) {                   \
+    return NAME##_avx512<Avx512<Real>>(__VA_ARGS__);        \
+  } else if constexpr (W == 32 / sizeof(Real)) {            \
+    if (avx2_) return NAME##_avx2<Avx2<Real>>(__VA_ARGS__); \
+  }                                                         \
   return NAME##_portable<PortableLanes<Real, W>>(__VA_ARGS__)
 #else
 #define MSFEM_DISPATCH(NAME, ...) return NAME##_portable<PortableLanes<Real, W>>(__VA_ARGS__)
 #endif
 
-// The kernels for one precision and lane count, the instruction set chosen once. Double takes
-// AVX-512VL's inverse square root where the CPU has it and `allow_avx512` (Avx512VlDouble).
+// The kernels for one precision and lane count, the instruction set chosen once: a 512-bit
+// vector's lanes (16 floats, 8 doubles) are AVX-512's, which the caller chose them for
+// (preferred_lanes); a 256-bit vector's AVX2's where the CPU has it; else the portable lanes.
 template <class Real, int W>
 class Kernels {
  public:
-  explicit Kernels(bool allow_avx512 = true)
-      : avx2_(cpu_has_avx2()), avx512_(allow_avx512 && cpu_has_avx512()) {}
+  Kernels() : avx2_(cpu_has_avx2()) {}
 
   // symplectic false: explicit Euler (x advances with the step's starting v).
   double explicit_step(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next, int begin,
@@ -263,6 +266,8 @@ class Kernels {
 #if MSFEM_HAVE_X86_DISPATCH
   template <class T>
   using Avx2 = std::conditional_t<std::is_same_v<T, float>, Avx2Float, Avx2Double>;
+  template <class T>
+  using Avx512 = std::conditional_t<std::is_same_v<T, float>, Avx512Float, Avx512Double>;
 #endif
   template <bool Symplectic>
   double explicit_step_damped(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
@@ -281,13 +286,9 @@ class Kernels {
   double explicit_step_for(const NodeGatherLayout<Real, W>& g, const Real* cur, Real* next,
                            int begin, int end, Real h) const {
 #if MSFEM_HAVE_X86_DISPATCH
-    if constexpr (W == 16) {
-      return explicit_chunks_avx512<Avx512Float, Damped, Symplectic>(g, cur, next, begin, end, h);
+    if constexpr (W * sizeof(Real) == 64) {
+      return explicit_chunks_avx512<Avx512<Real>, Damped, Symplectic>(g, cur, next, begin, end, h);
     } else if constexpr (W == 32 / sizeof(Real)) {
-      if constexpr (std::is_same_v<Real, double>)
-        if (avx512_)
-          return explicit_chunks_avx512<Avx512VlDouble, Damped, Symplectic>(g, cur, next, begin,
-                                                                            end, h);
       if (avx2_)
         return explicit_chunks_avx2<Avx2<Real>, Damped, Symplectic>(g, cur, next, begin, end, h);
     }
@@ -313,14 +314,10 @@ class Kernels {
   double rk4_stage_for(const NodeGatherLayout<Real, W>& g, const Real* in, const Real* base,
                        Real* out, Real* acc, int begin, int end, Real c, Real w) const {
 #if MSFEM_HAVE_X86_DISPATCH
-    if constexpr (W == 16) {
-      return rk4_stage_chunks_avx512<Avx512Float, Damped, Stage>(g, in, base, out, acc, begin, end,
-                                                                 c, w);
+    if constexpr (W * sizeof(Real) == 64) {
+      return rk4_stage_chunks_avx512<Avx512<Real>, Damped, Stage>(g, in, base, out, acc, begin, end,
+                                                                  c, w);
     } else if constexpr (W == 32 / sizeof(Real)) {
-      if constexpr (std::is_same_v<Real, double>)
-        if (avx512_)
-          return rk4_stage_chunks_avx512<Avx512VlDouble, Damped, Stage>(g, in, base, out, acc,
-                                                                        begin, end, c, w);
       if (avx2_)
         return rk4_stage_chunks_avx2<Avx2<Real>, Damped, Stage>(g, in, base, out, acc, begin, end,
                                                                 c, w);
@@ -347,14 +344,10 @@ class Kernels {
                              const CgVectors<Real>& cg, Real* p_records, int begin, int end, Real h,
                              double (&sums)[3]) const {
 #if MSFEM_HAVE_X86_DISPATCH
-    if constexpr (W == 16) {
-      return linearise_start_chunks_avx512<Avx512Float, Damped, Single>(
+    if constexpr (W * sizeof(Real) == 64) {
+      return linearise_start_chunks_avx512<Avx512<Real>, Damped, Single>(
           g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
     } else if constexpr (W == 32 / sizeof(Real)) {
-      if constexpr (std::is_same_v<Real, double>)
-        if (avx512_)
-          return linearise_start_chunks_avx512<Avx512VlDouble, Damped, Single>(
-              g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
       if (avx2_)
         return linearise_start_chunks_avx2<Avx2<Real>, Damped, Single>(
             g, records, dv_records, sys, cg, p_records, begin, end, h, sums);
@@ -368,12 +361,9 @@ class Kernels {
                      const Real* p_records, Real* const (&p)[3], Real* const (&y)[3], int begin,
                      int end) const {
 #if MSFEM_HAVE_X86_DISPATCH
-    if constexpr (W == 16) {
-      return product_chunks_avx512<Avx512Float, Single>(g, sys, p_records, p, y, begin, end);
+    if constexpr (W * sizeof(Real) == 64) {
+      return product_chunks_avx512<Avx512<Real>, Single>(g, sys, p_records, p, y, begin, end);
     } else if constexpr (W == 32 / sizeof(Real)) {
-      if constexpr (std::is_same_v<Real, double>)
-        if (avx512_)
-          return product_chunks_avx512<Avx512VlDouble, Single>(g, sys, p_records, p, y, begin, end);
       if (avx2_)
         return product_chunks_avx2<Avx2<Real>, Single>(g, sys, p_records, p, y, begin, end);
     }
@@ -382,7 +372,7 @@ class Kernels {
                                                                    end);
   }
 
-  bool avx2_, avx512_;
+  bool avx2_;
 };
 
 #undef MSFEM_DISPATCH

@@ -1,9 +1,8 @@
 #pragma once
 
 // x86 vector operations for the node-centric kernels (internal; see gather_kernels.hpp): AVX2
-// float (8 lanes), AVX2 double (4), AVX2 double with AVX-512VL's inverse square root (4) and
-// AVX-512 float (16). Each set carries its own target
-// attribute, so the library needs no -march flag and the steppers pick one at run time.
+// float (8 lanes), AVX2 double (4), AVX-512 double (8) and AVX-512 float (16). Each set carries its
+// own target attribute, so the library needs no -march flag and the steppers pick one at run time.
 //
 // Neighbour records are not gathered element by element: a record (x y z vx | vy vz pad pad) is one
 // or two vector loads, and a register transpose turns W records into six W-lane vectors. On the
@@ -139,7 +138,8 @@ struct Avx2Double {
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V fnmadd(V a, V b, V c) {
     return _mm256_fnmadd_pd(a, b, c);
   }
-  // Exact, for CPUs without AVX-512VL (Avx512VlDouble below refines the hardware estimate).
+  // Exact: a CPU with AVX-512 steps double on Avx512Double's eight lanes, which refines the
+  // hardware's estimate instead.
   MSFEM_TARGET_AVX2 static MSFEM_INLINE V inverse_sqrt(V a) {
     return _mm256_div_pd(set1(1.0), _mm256_sqrt_pd(a));
   }
@@ -199,16 +199,43 @@ struct Avx2Double {
   }
 };
 
-// Double on a CPU with AVX-512VL: the AVX2 lanes, but 1/√ from the hardware's 14-bit estimate and
-// two Newton steps (relative error ~2^-14, ~1e-8, then a few ulp) instead of a square root and a
-// division, and √ from it: those two share one unit, where the estimate and six multiplies run on
-// the FMA pipes beside the rest of the spring's arithmetic (4-5 % on a step, docs/design-notes.md).
-// A few ulp from the exact 1/√ is far below what the fast steppers are tested to (1e-9 of the
-// generic integrators' trajectories).
-struct Avx512VlDouble : Avx2Double {
+// Double on AVX-512's eight 64-bit lanes: records l and l + 4 in the two 256-bit halves of a
+// vector, 4x4 transposes per half. 1/√ comes from the hardware's 14-bit estimate and two Newton
+// steps (relative error ~2^-14, ~1e-8, then a few ulp) instead of a square root and a division,
+// and √ from it: those two share one unit, where the estimate and six multiplies run on the FMA
+// pipes beside the rest of the spring's arithmetic (4-5 % on a step, docs/design-notes.md). A few
+// ulp from the exact 1/√ is far below what the fast steppers are tested to (1e-9 of the generic
+// integrators' trajectories).
+struct Avx512Double {
+  using Real = double;
+  using V = __m512d;
+  static constexpr int W = 8;
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V load(const double* p) { return _mm512_loadu_pd(p); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store(double* p, V a) { _mm512_storeu_pd(p, a); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V load(const float* p) {
+    return _mm512_cvtps_pd(_mm256_loadu_ps(p));
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store(float* p, V a) {
+    _mm256_storeu_ps(p, _mm512_cvtpd_ps(a));
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V max(V a, V b) { return _mm512_max_pd(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V div(V a, V b) { return _mm512_div_pd(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V where_positive(V a, V b) {
+    return _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(a, _mm512_setzero_pd(), _CMP_GT_OQ), b);
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V set1(double a) { return _mm512_set1_pd(a); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V add(V a, V b) { return _mm512_add_pd(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V sub(V a, V b) { return _mm512_sub_pd(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V mul(V a, V b) { return _mm512_mul_pd(a, b); }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V fmadd(V a, V b, V c) {
+    return _mm512_fmadd_pd(a, b, c);
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V fnmadd(V a, V b, V c) {
+    return _mm512_fnmadd_pd(a, b, c);
+  }
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V inverse_sqrt(V a) {
     const V half_a = mul(set1(0.5), a);
-    V y = _mm256_rsqrt14_pd(a);
+    V y = _mm512_rsqrt14_pd(a);
     y = mul(y, fnmadd(mul(half_a, y), y, set1(1.5)));
     return mul(y, fnmadd(mul(half_a, y), y, set1(1.5)));
   }
@@ -220,9 +247,93 @@ struct Avx512VlDouble : Avx2Double {
   // √a for a value stored in float: one Newton step (~1e-8 relative, below float's 6e-8 rounding)
   // shortens the linearising pass's longest dependency chain by a multiply and a multiply-add.
   MSFEM_TARGET_AVX512 static MSFEM_INLINE V sqrt_to_float(V a) {
-    const V y = _mm256_rsqrt14_pd(a);
+    const V y = _mm512_rsqrt14_pd(a);
     const V root = mul(a, y);  // √a to 2^-14, refined: √a (3 - a y²) / 2
     return where_positive(a, mul(mul(set1(0.5), root), fnmadd(root, y, set1(3.0))));
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE double sum(V a) {
+    alignas(64) double lanes[W];
+    _mm512_store_pd(lanes, a);
+    double total = 0.0;
+    for (double value : lanes)
+      total += value;
+    return total;
+  }
+
+  template <int Stride>
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE V halves(const double* base, const int* index, int l,
+                                                   int offset) {
+    const V r = _mm512_castpd256_pd512(_mm256_load_pd(record_at<Stride>(base, index[l]) + offset));
+    return _mm512_insertf64x4(r, _mm256_load_pd(record_at<Stride>(base, index[l + 4]) + offset), 1);
+  }
+  // Four vectors of (a b c d) records, lanes l and l + 4 in each: a, b, c and d as 8-lane vectors.
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void transpose(const V (&r)[4], V (&out)[4]) {
+    const V t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
+    const V t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
+    const __m512i low = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
+    const __m512i high = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+    // t0 = a0 a1 c0 c1 | a4 a5 c4 c5, t2 = a2 a3 c2 c3 | a6 a7 c6 c7
+    out[0] = _mm512_permutex2var_pd(t0, low, t2);
+    out[1] = _mm512_permutex2var_pd(t1, low, t3);
+    out[2] = _mm512_permutex2var_pd(t0, high, t2);
+    out[3] = _mm512_permutex2var_pd(t1, high, t3);
+  }
+  template <bool WithVelocity, int Stride = kRecord>
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void load_records(const double* base, const int* index,
+                                                            V (&out)[6]) {
+    V r[4], t[4];
+    for (int l = 0; l < 4; ++l)
+      r[l] = halves<Stride>(base, index, l, 0);
+    transpose(r, t);
+    out[0] = t[0];
+    out[1] = t[1];
+    out[2] = t[2];
+    if constexpr (WithVelocity) {
+      out[3] = t[3];
+      for (int l = 0; l < 4; ++l)
+        r[l] = halves<Stride>(base, index, l, 4);
+      transpose(r, t);
+      out[4] = t[0];
+      out[5] = t[1];
+    }
+  }
+  // (GCC 12 warns that the plain extract's unused merge source is uninitialised.)
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE __m256d upper_half(V a) {
+    return _mm512_maskz_extractf64x4_pd(0xF, a, 1);
+  }
+  // The inverse of transpose: a, b, c, d as 8-lane vectors to (a b c d) records l and l + 4 in
+  // the halves of out[l].
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void untranspose(V a, V b, V c, V d, V (&out)[4]) {
+    const __m512i low = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
+    const __m512i high = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+    const V t0 = _mm512_permutex2var_pd(a, low, c), t2 = _mm512_permutex2var_pd(a, high, c);
+    const V t1 = _mm512_permutex2var_pd(b, low, d), t3 = _mm512_permutex2var_pd(b, high, d);
+    out[0] = _mm512_unpacklo_pd(t0, t1);
+    out[1] = _mm512_unpackhi_pd(t0, t1);
+    out[2] = _mm512_unpacklo_pd(t2, t3);
+    out[3] = _mm512_unpackhi_pd(t2, t3);
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store_records(double* base, const int* index,
+                                                             const V (&in)[6]) {
+    const V zero = _mm512_setzero_pd();
+    V r[4], q[4];
+    untranspose(in[0], in[1], in[2], in[3], r);
+    untranspose(in[4], in[5], zero, zero, q);
+    for (int l = 0; l < 4; ++l) {
+      _mm256_store_pd(record_at(base, index[l]), _mm512_castpd512_pd256(r[l]));
+      _mm256_store_pd(record_at(base, index[l + 4]), upper_half(r[l]));
+      _mm_store_pd(record_at(base, index[l]) + 4, _mm512_castpd512_pd128(q[l]));
+      _mm_store_pd(record_at(base, index[l + 4]) + 4, _mm256_castpd256_pd128(upper_half(q[l])));
+    }
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE void store_directions(double* base, const int* index,
+                                                                const V (&in)[3]) {
+    V r[4];
+    untranspose(in[0], in[1], in[2], _mm512_setzero_pd(), r);
+    for (int l = 0; l < 4; ++l) {
+      _mm256_store_pd(record_at<kDirection>(base, index[l]), _mm512_castpd512_pd256(r[l]));
+      _mm256_store_pd(record_at<kDirection>(base, index[l + 4]), upper_half(r[l]));
+    }
   }
 };
 

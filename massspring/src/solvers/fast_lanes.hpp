@@ -9,13 +9,17 @@
 
 namespace msfem::massspring::detail {
 
-/// Kernel<double, 4> in double precision; in single precision Kernel<float, 16> where
-/// preferred_lanes says the AVX-512 gathers pay for this network's size, else Kernel<float, 8>.
+/// Kernel<Real, preferred_lanes<Real>(...)>: double 8 lanes (AVX-512) or 4, float 16 (AVX-512,
+/// while this network fits the cache) or 8.
 template <template <class, int> class Kernel, class Base, class Options>
 std::unique_ptr<Base> kernel_for_lanes(const MechanicalSystem& system, const Options& options,
                                        bool allow_avx512) {
-  if (!options.single_precision) return std::make_unique<Kernel<double, 4>>(system, options);
   const long springs = spring_field(system, "the fast stepper").network().num_springs();
+  if (!options.single_precision) {
+    if (preferred_lanes<double>(allow_avx512, springs, system.num_nodes()) == 8)
+      return std::make_unique<Kernel<double, 8>>(system, options);
+    return std::make_unique<Kernel<double, 4>>(system, options);
+  }
   if (preferred_lanes<float>(allow_avx512, springs, system.num_nodes()) == 16)
     return std::make_unique<Kernel<float, 16>>(system, options);
   return std::make_unique<Kernel<float, 8>>(system, options);

@@ -51,8 +51,7 @@ class GatherExplicitStepper final : public FastExplicitStepper::Implementation {
         records_{detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2)),
                  detail::AlignedVector<Real>(kRecord * (soa_.num_nodes + 2))},
         range_tickets_(static_cast<std::size_t>(team_.size())),
-        integrator_(options.integrator),
-        kernels_(options.allow_avx512) {
+        integrator_(options.integrator) {
     gather_.partition_for(team_.size());
     if (integrator_ == IntegratorKind::rk4)
       for (auto& stage : stages_)

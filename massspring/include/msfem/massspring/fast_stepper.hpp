@@ -13,8 +13,9 @@ struct FastStepperOptions {
   int threads = 2;                ///< threads in all, the calling one included
   bool single_precision = false;  ///< float arithmetic (twice the SIMD width, ~1e-7 relative)
   bool reorder_nodes = true;      ///< reverse Cuthill-McKee order for memory locality
-  /// float: 16 lanes where the CPU has AVX-512 (else 8, AVX2); double: 1/√ from AVX-512VL's
-  /// estimate refined to a few ulp (else a square root and a division)
+  /// float: 16 lanes where the CPU has AVX-512 and the network fits the cache (else 8, AVX2);
+  /// double: 8 lanes where the CPU has AVX-512, 1/√ from its estimate refined to a few ulp (else
+  /// 4 lanes of AVX2, a square root and a division)
   bool allow_avx512 = true;
   /// The scheme, as the generic Integrator of the same kind steps it: symplectic_euler,
   /// explicit_euler (x ← x + h v with the step's starting v, at the symplectic step's cost) or rk4
