@@ -48,10 +48,11 @@ struct FastStepperOptions {
 /// last one wrote (two more buffers) and a barrier apart. Springs are stored per node in
 /// vector-width chunks (sliced ELLPACK) with their k and k l0 (and c, unless one damping serves all
 /// springs) beside the neighbour index. Each spring is evaluated twice, once per end: more
-/// arithmetic for far less memory traffic. Threads take blocks of chunks from a shared counter, so
-/// a thread the OS pre-empts delays a step by one block. The kernels (gather_kernels.hpp) are
-/// compiled for baseline x86-64, AVX2+FMA (float 8 lanes, double 4) and AVX-512 (float 16, while
-/// the model fits in cache) and picked at run time.
+/// arithmetic for far less memory traffic. Each thread takes blocks of chunks from its own range
+/// first and then from what is left of the others', so a thread the OS pre-empts delays a step by
+/// one block. The kernels (gather_kernels.hpp) are compiled for baseline x86-64, AVX2+FMA (float 8
+/// lanes, double 4) and AVX-512 (float 16, while the model fits in cache; double 8) and picked at
+/// run time.
 class FastExplicitStepper : public Stepper {
  public:
   explicit FastExplicitStepper(const MechanicalSystem& model,
