@@ -129,8 +129,9 @@ template <class S, int Stride = kRecord>
 MSFEM_INLINE void prefetch_neighbours(const typename S::Real* base,
                                       const AlignedVector<int>& neighbour, int slot) {
 #if defined(__GNUC__)
-  if constexpr (kPrefetchSlots < S >> 0) {
-    const int ahead = slot + kPrefetchSlots<S>;
+  constexpr int kAhead = kPrefetchSlots<S>;
+  if constexpr (kAhead > 0) {
+    const int ahead = slot + kAhead;
     if (ahead + S::W > static_cast<int>(neighbour.size())) return;
     for (int l = 0; l < S::W; ++l)
       __builtin_prefetch(record_at<Stride>(base, neighbour[static_cast<std::size_t>(ahead + l)]));

@@ -266,17 +266,22 @@ struct Avx512Double {
     const V r = _mm512_castpd256_pd512(_mm256_load_pd(record_at<Stride>(base, index[l]) + offset));
     return _mm512_insertf64x4(r, _mm256_load_pd(record_at<Stride>(base, index[l + 4]) + offset), 1);
   }
+  // Pairs of lanes from two vectors: (0 1 from the second's 0 1) per half, and the same for 2 3.
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE __m512i first_pairs() {
+    return _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
+  }
+  MSFEM_TARGET_AVX512 static MSFEM_INLINE __m512i second_pairs() {
+    return _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+  }
   // Four vectors of (a b c d) records, lanes l and l + 4 in each: a, b, c and d as 8-lane vectors.
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void transpose(const V (&r)[4], V (&out)[4]) {
     const V t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
     const V t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
-    const __m512i low = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
-    const __m512i high = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
     // t0 = a0 a1 c0 c1 | a4 a5 c4 c5, t2 = a2 a3 c2 c3 | a6 a7 c6 c7
-    out[0] = _mm512_permutex2var_pd(t0, low, t2);
-    out[1] = _mm512_permutex2var_pd(t1, low, t3);
-    out[2] = _mm512_permutex2var_pd(t0, high, t2);
-    out[3] = _mm512_permutex2var_pd(t1, high, t3);
+    out[0] = _mm512_permutex2var_pd(t0, first_pairs(), t2);
+    out[1] = _mm512_permutex2var_pd(t1, first_pairs(), t3);
+    out[2] = _mm512_permutex2var_pd(t0, second_pairs(), t2);
+    out[3] = _mm512_permutex2var_pd(t1, second_pairs(), t3);
   }
   template <bool WithVelocity, int Stride = kRecord>
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void load_records(const double* base, const int* index,
@@ -304,10 +309,10 @@ struct Avx512Double {
   // The inverse of transpose: a, b, c, d as 8-lane vectors to (a b c d) records l and l + 4 in
   // the halves of out[l].
   MSFEM_TARGET_AVX512 static MSFEM_INLINE void untranspose(V a, V b, V c, V d, V (&out)[4]) {
-    const __m512i low = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
-    const __m512i high = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
-    const V t0 = _mm512_permutex2var_pd(a, low, c), t2 = _mm512_permutex2var_pd(a, high, c);
-    const V t1 = _mm512_permutex2var_pd(b, low, d), t3 = _mm512_permutex2var_pd(b, high, d);
+    const V t0 = _mm512_permutex2var_pd(a, first_pairs(), c),
+            t2 = _mm512_permutex2var_pd(a, second_pairs(), c);
+    const V t1 = _mm512_permutex2var_pd(b, first_pairs(), d),
+            t3 = _mm512_permutex2var_pd(b, second_pairs(), d);
     out[0] = _mm512_unpacklo_pd(t0, t1);
     out[1] = _mm512_unpackhi_pd(t0, t1);
     out[2] = _mm512_unpacklo_pd(t2, t3);
