@@ -15,6 +15,7 @@
 #include "kernels/soa_layout.hpp"
 #include "kernels/thread_team.hpp"
 #include "solvers/fast_lanes.hpp"
+#include "solvers/warm_start_trend.hpp"
 
 namespace msfem::massspring {
 
@@ -65,6 +66,10 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         direction_pointers_[c] = direction_[c].data();
         direction_product_pointers_[c] = direction_product_[c].data();
       }
+    for (int c = 0; c < 3; ++c) {
+      last_dv_[c].assign(lanes, Real(0));
+      trend_[c].assign(lanes, Real(0));
+    }
     for (int e = 0; e < 6; ++e) {
       inverse_block_[e].assign(lanes, Real(0));
       cg_.inverse_block[e] = inverse_block_[e].data();
@@ -72,6 +77,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     take_fields(model);
     for (auto& sums : block_sums_)
       sums.assign(3 * static_cast<std::size_t>(blocks()), 0.0);
+    trend_sums_.assign(2 * static_cast<std::size_t>(blocks()), 0.0);
     pack();
   }
 
@@ -82,11 +88,13 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     model_ = &model;
     take_fields(model);
     pack();
+    forget_trend();
   }
   void set_state(const State& state) override {
     soa_.set_state(*model_, state);
     time_ = state.time;
     pack();
+    forget_trend();
   }
   State state() const override {
     State out{Eigen::VectorXd(3 * soa_.num_nodes), Eigen::VectorXd(3 * soa_.num_nodes), time_};
@@ -111,6 +119,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     const Real h = static_cast<Real>(dt);
     const int members = threads_.choose();
     const auto start = std::chrono::steady_clock::now();
+    const Real theta = static_cast<Real>(trend_factor(dt));
     int iterations = 0;
     const std::function<void(int)> job = [&](int member) {
       const int b0 = members == 1 ? 0 : member_block_[member];
@@ -133,7 +142,12 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         // barrier of the other.
         parity ^= 1;
       };
-      // One pass: linearise, and start CG from the warm start (the last step's Δv, cg_advance).
+      if (theta > 0) {
+        start_on_trend(b0, b1, theta);
+        if (members > 1) team_.barrier();
+      }
+      // One pass: linearise, and start CG from the warm start (the last step's Δv, cg_advance,
+      // or its trend).
       double sums[3];  // r·u, r·r, b·b; the barrier also completes the u records
       if (!fields_.empty()) fields_.gather_state(b0, b1, records_.data(), dv_records_.data(), h);
       reduced(
@@ -209,6 +223,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       // step's first pass reads the records after the step returns.
       kernels_.cg_advance(gather_, cg_, records_.data(), dv_records_.data(),
                           gather_.block_begin[b0], gather_.block_begin[b1], h);
+      for (int block = b0; block < b1; ++block)
+        follow_trend(block);
       if (member == 0) iterations = iteration;
     };
     if (members == 1)
@@ -216,6 +232,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     else
       team_.run(job);
     last_iterations_ = iterations;
+    warm_start_.record(iterations);
+    ++trend_steps_;
     time_ += dt;
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
     threads_.record(members, took.count() / (iterations + 2.0));  // per product
@@ -281,6 +299,57 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     return unit * unit * sum;
   }
 
+  // θ times warm_start_'s factor for this step: 0 until the Δv of kTrendSteps steps at this dt
+  // are known. θ = (Δv_n − Δv_n−1)·(Δv_n−1 − Δv_n−2) / |Δv_n−1 − Δv_n−2|², summed by block, in
+  // [0, 1].
+  double trend_factor(double dt) {
+    if (dt != trend_dt_) {
+      forget_trend();
+      trend_dt_ = dt;
+    }
+    if (!options_.trend_start || trend_steps_ < kTrendSteps) return 0.0;
+    double along = 0.0, squared = 0.0;
+    for (int block = 0; block < blocks(); ++block) {
+      along += trend_sums_[2 * static_cast<std::size_t>(block)];
+      squared += trend_sums_[2 * static_cast<std::size_t>(block) + 1];
+    }
+    const double fit = squared > 0.0 ? std::clamp(along / squared, 0.0, 1.0) : 0.0;
+    return warm_start_.factor() * fit;
+  }
+  void forget_trend() {
+    trend_steps_ = 0;
+    warm_start_ = {};
+  }
+  // The warm start Δv_n + θ (Δv_n − Δv_n−1) at this member's lanes, in cg.dv and the Δv records.
+  void start_on_trend(int b0, int b1, Real theta) {
+    const std::size_t first = static_cast<std::size_t>(gather_.block_begin[b0]) * W,
+                      last = static_cast<std::size_t>(gather_.block_begin[b1]) * W;
+    for (std::size_t lane = first; lane < last; ++lane) {
+      if (gather_.lane_node[lane] == gather_.idle_record) continue;
+      Real* record =
+          detail::record_at<detail::kDirection>(dv_records_.data(), gather_.lane_offset[lane]);
+      for (int c = 0; c < 3; ++c)
+        record[c] = dv_[c][lane] = last_dv_[c][lane] + theta * trend_[c][lane];
+    }
+  }
+  // After the step, at block `block`'s lanes: the sums of trend_factor's fit, then Δv_n − Δv_n−1
+  // and Δv_n kept for the next.
+  void follow_trend(int block) {
+    const std::size_t first = static_cast<std::size_t>(gather_.block_begin[block]) * W,
+                      last = static_cast<std::size_t>(gather_.block_begin[block + 1]) * W;
+    double along = 0.0, squared = 0.0;
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t lane = first; lane < last; ++lane) {
+        const Real change = dv_[c][lane] - last_dv_[c][lane], before = trend_[c][lane];
+        along += static_cast<double>(change) * before;
+        squared += static_cast<double>(before) * before;
+        trend_[c][lane] = change;
+        last_dv_[c][lane] = dv_[c][lane];
+      }
+    trend_sums_[2 * static_cast<std::size_t>(block)] = along;
+    trend_sums_[2 * static_cast<std::size_t>(block) + 1] = squared;
+  }
+
   // r·u, r·r and b·b over the lanes of block `block`, once the fields have changed r and u.
   void start_sums(int block, double* out) const {
     double sums[3] = {0.0, 0.0, 0.0};
@@ -331,6 +400,14 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   detail::AlignedVector<Real> records_;     // x, v per node
   detail::AlignedVector<Real> p_records_;   // u = B⁻¹ r per node (zero on constrained nodes)
   detail::AlignedVector<Real> dv_records_;  // the last step's Δv per node (zero on constrained)
+  // The trend start (warm_start_trend.hpp): per lane Δv_n and Δv_n − Δv_n−1; per block the fit's
+  // two sums.
+  detail::AlignedVector<Real> last_dv_[3], trend_[3];
+  std::vector<double> trend_sums_;
+  detail::WarmStartTrend warm_start_;
+  static constexpr int kTrendSteps = 3;  // a fit needs three Δv at one dt
+  int trend_steps_ = 0;
+  double trend_dt_ = 0.0;
   detail::ImplicitCoefficients<Real> system_;
   detail::ImplicitFields<Real, W> fields_;
   detail::AlignedVector<Real> rhs_[3];  // b in lane order, with fields only
