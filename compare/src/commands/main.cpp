@@ -90,8 +90,8 @@ const std::vector<CommandEntry>& commands() {
        "      largest component, cavities filled, CGAL Mesh_3 extraction, then simplification"},
       {"bench", bench_command,
        "bench massspring [--json] [--mesh-dir DIR] [--threads N] [--samples N] [--seconds S]\n"
-       "          [--float] [--no-10x]\n"
-       "      stepping speed of the mass-spring models"},
+       "          [--float] [--no-10x] [--cases NAME,...]\n"
+       "      stepping speed of the mass-spring models (--cases: only those, by name)"},
       {"verify", verify_command,
        "verify [--json] [--no-locking]\n      the FEM reference against closed-form solutions"},
   };
