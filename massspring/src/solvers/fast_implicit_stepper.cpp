@@ -111,7 +111,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
   int num_nodes() const override { return soa_.num_nodes; }
   int num_springs() const override { return soa_.num_springs; }
 
-  // Solves (M - h D - h² K) Δv = h (f + h K v) by CG from the last step's Δv, to
+  // Solves (M - h D - h² K) Δv = h (f + h K v) by CG from the last step's Δv or its trend, to
   // ‖r‖ <= cg_tolerance ‖b‖ (or b's rounding noise, spring_rounding) or cg_max_iterations, then
   // v += Δv, x += h v.
   void step(double dt) override {
@@ -119,7 +119,8 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     const Real h = static_cast<Real>(dt);
     const int members = threads_.choose();
     const auto start = std::chrono::steady_clock::now();
-    const Real theta = static_cast<Real>(trend_factor(dt));
+    const bool follow = following_trend(dt);
+    const Real theta = follow ? static_cast<Real>(trend_theta()) : Real(0);
     int iterations = 0;
     const std::function<void(int)> job = [&](int member) {
       const int b0 = members == 1 ? 0 : member_block_[member];
@@ -223,8 +224,9 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       // step's first pass reads the records after the step returns.
       kernels_.cg_advance(gather_, cg_, records_.data(), dv_records_.data(),
                           gather_.block_begin[b0], gather_.block_begin[b1], h);
-      for (int block = b0; block < b1; ++block)
-        follow_trend(block);
+      if (follow)
+        for (int block = b0; block < b1; ++block)
+          follow_trend(block);
       if (member == 0) iterations = iteration;
     };
     if (members == 1)
@@ -233,7 +235,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
       team_.run(job);
     last_iterations_ = iterations;
     warm_start_.record(iterations);
-    ++trend_steps_;
+    if (follow) trend_steps_ = std::min(trend_steps_ + 1, kTrendSteps);
     time_ += dt;
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
     threads_.record(members, took.count() / (iterations + 2.0));  // per product
@@ -299,22 +301,27 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
     return unit * unit * sum;
   }
 
-  // θ times warm_start_'s factor for this step: 0 until the Δv of kTrendSteps steps at this dt
-  // are known. θ = (Δv_n − Δv_n−1)·(Δv_n−1 − Δv_n−2) / |Δv_n−1 − Δv_n−2|², summed by block, in
-  // [0, 1].
-  double trend_factor(double dt) {
+  // Whether this step keeps the trend (warm_start_trend.hpp): while CG is slow at this dt. The
+  // history starts anew each time, so a model whose CG converges fast pays nothing for it.
+  bool following_trend(double dt) {
     if (dt != trend_dt_) {
       forget_trend();
       trend_dt_ = dt;
     }
-    if (!options_.trend_start || trend_steps_ < kTrendSteps) return 0.0;
+    if (options_.trend_start && warm_start_.slow()) return true;
+    trend_steps_ = 0;
+    return false;
+  }
+  // θ = (Δv_n − Δv_n−1)·(Δv_n−1 − Δv_n−2) / |Δv_n−1 − Δv_n−2|², summed by block, in [0, 1];
+  // 0 until kTrendSteps steps have kept the trend.
+  double trend_theta() const {
+    if (trend_steps_ < kTrendSteps) return 0.0;
     double along = 0.0, squared = 0.0;
     for (int block = 0; block < blocks(); ++block) {
       along += trend_sums_[2 * static_cast<std::size_t>(block)];
       squared += trend_sums_[2 * static_cast<std::size_t>(block) + 1];
     }
-    const double fit = squared > 0.0 ? std::clamp(along / squared, 0.0, 1.0) : 0.0;
-    return warm_start_.factor() * fit;
+    return squared > 0.0 ? std::clamp(along / squared, 0.0, 1.0) : 0.0;
   }
   void forget_trend() {
     trend_steps_ = 0;
@@ -332,7 +339,7 @@ class GatherImplicitStepper final : public FastImplicitStepper::Implementation {
         record[c] = dv_[c][lane] = last_dv_[c][lane] + theta * trend_[c][lane];
     }
   }
-  // After the step, at block `block`'s lanes: the sums of trend_factor's fit, then Δv_n − Δv_n−1
+  // After the step, at block `block`'s lanes: the sums of trend_theta's fit, then Δv_n − Δv_n−1
   // and Δv_n kept for the next.
   void follow_trend(int block) {
     const std::size_t first = static_cast<std::size_t>(gather_.block_begin[block]) * W,

@@ -45,7 +45,8 @@ struct FastImplicitOptions {
   /// from the trend of the last steps, Δv_n + θ (Δv_n - Δv_n-1), θ fitted to the last two
   /// changes, instead of Δv_n: on the brain with volume preservation on its prisms that halves
   /// the iterations. Where CG converges in a few iterations the trend start does not pay and is
-  /// not taken. Only the start changes: every step is still solved to cg_tolerance.
+  /// not taken. Only the start changes: every step is still solved to cg_tolerance. The trend is
+  /// kept over steps of one dt: a step of another dt (compared exactly) starts it anew.
   bool trend_start = true;
 };
 
