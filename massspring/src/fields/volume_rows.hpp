@@ -1,7 +1,5 @@
 #pragma once
 
-#include <vector>
-
 // The volume tangent's row sums (internal to the volume field): a node's row of a product is the
 // sum over the elements at the node of the element's factor times its gradient there. Each
 // incidence keeps its gradient as a four-double record (gx gy gz 0) in row order, so a row sums
@@ -32,13 +30,6 @@ void add_row_sums(const RowIncidences& rows, const double* s, double* df);
 /// (xy, yz, zx), each padded to four, with k = c·scale[lane].
 void start_row_sums(const RowIncidences& rows, const int* g_at, const double* g, double* g_rows,
                     const double* s1, const double* s2, const double* scale, double c, double* out);
-
-/// Vectors in records of four doubles per node (x y z, the fourth unread), for the dot kernels
-/// below: one load per node and a transpose of four, instead of three scalar loads put together
-/// lane by lane.
-void to_records(const double* x, int nodes, double* records);
-/// The same with node i's record at 4 record_of_node[i].
-void to_records(const double* x, const std::vector<int>& record_of_node, double* records);
 
 /// group_dot (volume_batches.hpp) from vectors in records: x4 at record[k·L + l] (4 × the node
 /// record, the group layout of b.offset) for node k of lane l. One vector: out1 = scale factor

@@ -110,6 +110,15 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
           }
         if (touches) p.groups.push_back(group);
       }
+      std::vector<char> read(row_of.size(), 0);
+      for (int group : p.groups) {
+        const int* offset = batches_->offset.data() + batches_->group_start[group];
+        for (int k = 0; k < batches_->nodes(group); ++k)
+          for (int l = 0; l < batches_->group_lanes[group]; ++l)
+            read[static_cast<std::size_t>(offset[k * L + l] / 3)] = 1;
+      }
+      for (std::size_t node = 0; node < read.size(); ++node)
+        if (read[node]) p.read.push_back(static_cast<int>(node));
       p.row_start.push_back(0);
       for (const auto& incidences : at_row) {
         for (const auto& [lane, g] : incidences) {
@@ -139,7 +148,7 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
 
   void add_product_rows(const Eigen::VectorXd& dx, Eigen::VectorXd& df, int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
-    to_own_records(dx, p.x1);
+    to_own_records(dx, p.read, p.x1);
     add_product_rows_records(p.x1.data(), 1.0, df, plan);
   }
 
@@ -183,8 +192,8 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
                   Eigen::VectorXd& df2, double cx, std::vector<Eigen::Matrix3d>& blocks,
                   int plan) const override {
     const RowPlan& p = plans_[static_cast<std::size_t>(plan)];
-    to_own_records(dx1, p.x1);
-    to_own_records(dx2, p.x2);
+    to_own_records(dx1, p.read, p.x1);
+    to_own_records(dx2, p.read, p.x2);
     for (int group : p.groups) {
       const std::size_t first = static_cast<std::size_t>(group) * L;
       detail::group_dot_pair_records(*batches_, group, gradient(group), record_.data(), p.x1.data(),
@@ -349,12 +358,18 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     return 1 + static_cast<std::size_t>(
                    *std::max_element(record_of_node_.begin(), record_of_node_.end()));
   }
-  // A vector over the model's nodes into records in record_'s order.
-  void to_own_records(const Eigen::VectorXd& dx, std::vector<double>& records) const {
-    if (record_of_node_.empty())
-      detail::to_records(dx.data(), static_cast<int>(dx.size() / 3), records.data());
-    else
-      detail::to_records(dx.data(), record_of_node_, records.data());
+  // A vector at nodes `nodes` into records of four doubles (x y z, the fourth unread) in record_'s
+  // order, for the dot kernels (volume_rows.hpp): one load per node and a transpose of four
+  // instead of three scalar loads put together lane by lane. A plan converts only the nodes its
+  // groups read.
+  void to_own_records(const Eigen::VectorXd& dx, const std::vector<int>& nodes,
+                      std::vector<double>& records) const {
+    for (int node : nodes) {
+      const std::size_t at =
+          4 * static_cast<std::size_t>(record_of_node_.empty() ? node : record_of_node_[node]);
+      for (int c = 0; c < 3; ++c)
+        records[at + c] = dx[3 * static_cast<Eigen::Index>(node) + c];
+    }
   }
   double* gradient(int group) { return g_.data() + 3 * batches_->group_start[group]; }
   const double* gradient(int group) const { return g_.data() + 3 * batches_->group_start[group]; }
@@ -365,12 +380,13 @@ class DefiniteVolumeTangent final : public ForceField::Tangent {
     std::vector<int> lane;           // per incidence: its element's group lane (group·L + l)
     std::vector<int> g_at;           // per incidence: where its g_x is in g_ (g_y, g_z L and 2L on)
     std::vector<int> groups;         // the groups with an element at a row
+    std::vector<int> read;           // the nodes of those groups' elements, ascending
     mutable std::vector<double> s;   // per group lane: −κ/|V⁰| (g·dx)/36 at `groups`
     mutable std::vector<double> s2;  // per group lane: start_rows's second factor
     // Per incidence, its g (x y z 0) in row order, gathered by start_rows for the step's products.
     mutable std::vector<double> g_rows;
     mutable std::vector<double> row_out;  // per row: start_row_sums's 16 sums
-    mutable std::vector<double> x1, x2;   // the products' vectors in records (detail::to_records)
+    mutable std::vector<double> x1, x2;   // the products' vectors in records (to_own_records)
     mutable bool rows_gathered = false;
   };
   static detail::RowIncidences incidences(const RowPlan& p) {
